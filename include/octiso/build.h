@@ -1,0 +1,57 @@
+// Building an Octree<T> bottom-up from a dense VolumeView<T> (Knoll et al. 2006, Sec. 3.1, 3.3,
+// 4.1), in parallel with TBB: lossless consolidation of uniform siblings into scalar leaves,
+// min/max over each child's cells including the forward layer, padding as "don't care", optional
+// iso-range clamping and lossy tolerance. OctreeData<T> owns the result; view() reads it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "octiso/octree.h"
+#include "octiso/volume.h"
+
+namespace octiso {
+
+struct BuildOptions {
+    /// --iso-range LO,HI: a voxel below LO (above HI) becomes LO (HI) wherever that changes no
+    /// cell that reaches into (LO,HI), so every isosurface with LO < iso < HI stays exact.
+    std::optional<std::array<double, 2>> iso_range;
+    /// --tolerance EPS: siblings whose values all lie within EPS of one representative merge.
+    double tolerance = 0.0;
+    /// --nan-as V: NaN and +-Inf become V; without it a non-finite value is an error.
+    std::optional<double> nan_as;
+    int threads = 0;               ///< 0: all cores (the caller's tbb::global_control applies)
+    std::string source_name;       ///< named in errors
+};
+
+/// Counts per depth d = 0 .. dmax-1: stored nodes (interior; caps at dmax-1) and scalar leaves
+/// (children of depth-d nodes that are leaves, data-covering or padding).
+struct BuildStats {
+    std::vector<uint64_t> nodes_per_depth;
+    std::vector<uint64_t> scalar_leaves_per_depth;
+    uint64_t interior_bytes = 0;   ///< all InteriorNode records, min/max included
+    uint64_t minmax_bytes = 0;     ///< the part of interior_bytes that is min/max
+    uint64_t cap_bytes = 0;
+    double seconds = 0;
+};
+
+template <typename T> class OctreeData {
+public:
+    OctreeData() = default;
+    Octree<T> view() const;
+    const BuildStats& stats() const { return stats_; }
+
+    Dims dims;
+    int dmax = 0;
+    std::vector<std::vector<InteriorNode<T>>> nodes;   ///< [depth 0 .. dmax-2]
+    std::vector<Cap<T>> caps;
+    BuildStats stats_;
+};
+
+/// Builds the octree of `volume`. Throws Error(options.source_name, ...) on non-finite data
+/// without nan_as, or on a tree too large for 32-bit child indices.
+template <typename T> OctreeData<T> build_octree(const VolumeView<T>& volume, const BuildOptions& options);
+
+}  // namespace octiso

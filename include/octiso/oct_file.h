@@ -1,0 +1,82 @@
+// The .oct file: a versioned header, one or more time steps of one octree each, a section table,
+// 64-byte aligned sections with an XXH3 checksum each. OctWriter streams steps to a temporary
+// file and renames it on success (never a partial output). OctFile maps a file read-only and
+// hands out zero-copy Octree<T> views, each step validated completely before its first use.
+// The byte layout is drawn in src/format/oct_layout.h.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "octiso/octree.h"
+#include "octiso/volume.h"
+
+namespace octiso {
+
+/// What a .oct file says about its data, shared by all steps.
+struct OctInfo {
+    ScalarType type = ScalarType::u8;
+    Dims dims;
+    Placement placement;
+    int dmax = 0;
+    std::optional<std::array<double, 2>> iso_range;   ///< converted with --iso-range LO,HI
+    double tolerance = 0.0;                            ///< 0: lossless
+    uint32_t step_count = 0;
+};
+
+/// Streams an .oct file: open, add_step() once per time step in order, finish(). Until finish()
+/// returns, only a temporary sibling file exists; the destructor removes it if finish() never ran.
+class OctWriter {
+public:
+    OctWriter(std::string path, const OctInfo& info);   ///< info.step_count is filled in by finish()
+    ~OctWriter();
+    OctWriter(const OctWriter&) = delete;
+    OctWriter& operator=(const OctWriter&) = delete;
+
+    template <typename T> void add_step(const Octree<T>& octree);
+    void finish();
+    uint64_t bytes_written() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// How much of each step the loader checks before handing it out.
+enum class Verify { Full, IndicesOnly };   ///< Full also recomputes every section checksum
+
+/// Section sizes of one step, for reports.
+struct StepSizes {
+    uint64_t interior_bytes = 0, minmax_bytes = 0, cap_bytes = 0;
+    std::vector<uint64_t> nodes_per_depth;          ///< d = 0 .. dmax-1 (caps last)
+    std::vector<uint64_t> scalar_leaves_per_depth;  ///< leaf children of depth-d nodes
+};
+
+class OctFile {
+public:
+    /// Maps `path` and validates header and section table. Throws Error(path, ...) on any defect.
+    static OctFile open(const std::string& path, Verify verify = Verify::Full);
+    OctFile(OctFile&&) noexcept;
+    OctFile& operator=(OctFile&&) noexcept;
+    ~OctFile();
+
+    const OctInfo& info() const;
+    const std::string& path() const;
+    uint64_t file_bytes() const;
+    /// Step k as a zero-copy view; its sections are validated on the first call (thread-safe).
+    /// Throws Error(path, ...) if T is not the file's type, k is out of range, or the step is bad.
+    template <typename T> Octree<T> step(uint32_t k) const;
+    /// Sizes of step k (validates it first, like step()).
+    StepSizes step_sizes(uint32_t k) const;
+
+private:
+    OctFile();
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace octiso

@@ -1,0 +1,107 @@
+// Volumes as the rest of octiso sees them: the scalar types of CONVENTIONS 1, grid dimensions
+// with overflow-checked voxel counts, world placement (spacing, origin), and VolumeView<T>, a
+// non-owning x-fastest view over raw bytes (mmap'd file or VTK buffer) that may need byte swaps.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <type_traits>
+
+namespace octiso {
+
+/// Stored scalar types; the numeric values are part of the .oct format (never renumber).
+enum class ScalarType : uint8_t { u8 = 0, i8 = 1, u16 = 2, i16 = 3, u32 = 4, i32 = 5, f32 = 6, f64 = 7 };
+inline constexpr int kScalarTypeCount = 8;
+
+std::string_view scalar_type_name(ScalarType t);
+std::optional<ScalarType> parse_scalar_type(std::string_view name);   ///< "u8" .. "f64"
+size_t scalar_type_bytes(ScalarType t);
+
+template <typename T> constexpr ScalarType scalar_type_of() {
+    if constexpr (std::is_same_v<T, uint8_t>) return ScalarType::u8;
+    else if constexpr (std::is_same_v<T, int8_t>) return ScalarType::i8;
+    else if constexpr (std::is_same_v<T, uint16_t>) return ScalarType::u16;
+    else if constexpr (std::is_same_v<T, int16_t>) return ScalarType::i16;
+    else if constexpr (std::is_same_v<T, uint32_t>) return ScalarType::u32;
+    else if constexpr (std::is_same_v<T, int32_t>) return ScalarType::i32;
+    else if constexpr (std::is_same_v<T, float>) return ScalarType::f32;
+    else { static_assert(std::is_same_v<T, double>, "unsupported scalar type"); return ScalarType::f64; }
+}
+
+/// The single runtime-to-template switch: calls f(T{}) with the C++ type of `t`.
+template <typename F> decltype(auto) dispatch_scalar_type(ScalarType t, F&& f) {
+    switch (t) {
+        case ScalarType::u8: return f(uint8_t{});
+        case ScalarType::i8: return f(int8_t{});
+        case ScalarType::u16: return f(uint16_t{});
+        case ScalarType::i16: return f(int16_t{});
+        case ScalarType::u32: return f(uint32_t{});
+        case ScalarType::i32: return f(int32_t{});
+        case ScalarType::f32: return f(float{});
+        case ScalarType::f64: break;
+    }
+    return f(double{});
+}
+
+/// Grid size in voxels. Each extent is in [1, kMaxExtent]; voxels() cannot overflow 64 bits.
+struct Dims {
+    uint32_t x = 0, y = 0, z = 0;
+    static constexpr uint32_t kMaxExtent = 1u << 30;   // keeps N = 2^dmax representable in uint32
+    uint64_t voxels() const { return uint64_t(x) * y * z; }
+    uint32_t max_extent() const { return x > y ? (x > z ? x : z) : (y > z ? y : z); }
+    bool operator==(const Dims&) const = default;
+};
+
+/// Parses "NX,NY,NZ"; throws Error(flag, ...) on anything but three integers in [1, kMaxExtent].
+Dims parse_dims(std::string_view text, const std::string& flag);
+/// Byte count of dims x scalar size; throws Error(subject, ...) if it overflows 64 bits.
+uint64_t checked_volume_bytes(Dims dims, ScalarType type, const std::string& subject);
+
+/// World placement: voxel (i,j,k) sits at origin + (i*SX, j*SY, k*SZ) (CONVENTIONS 1).
+struct Placement {
+    std::array<double, 3> spacing{1.0, 1.0, 1.0};
+    std::array<double, 3> origin{0.0, 0.0, 0.0};
+};
+
+/// Non-owning x-fastest view of NX*NY*NZ scalars of type T, starting at `data`. The bytes may be
+/// unaligned (raw files with --offset) and of the other endianness (swap_bytes), so every load
+/// goes through memcpy; for aligned native data that compiles to a plain load.
+template <typename T> struct VolumeView {
+    const std::byte* data = nullptr;
+    Dims dims;
+    bool swap_bytes = false;
+
+    uint64_t index(uint32_t x, uint32_t y, uint32_t z) const {
+        return uint64_t(x) + uint64_t(dims.x) * (uint64_t(y) + uint64_t(dims.y) * z);
+    }
+    T load(uint64_t i) const {
+        T v;
+        std::memcpy(&v, data + i * sizeof(T), sizeof(T));
+        if (swap_bytes) v = byte_swapped(v);
+        return v;
+    }
+    T at(uint32_t x, uint32_t y, uint32_t z) const { return load(index(x, y, z)); }
+
+    static T byte_swapped(T v) {
+        if constexpr (sizeof(T) == 1) {
+            return v;
+        } else {
+            using U = std::conditional_t<sizeof(T) == 2, uint16_t, std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>>;
+            U u;
+            std::memcpy(&u, &v, sizeof(T));
+            if constexpr (sizeof(T) == 2) u = __builtin_bswap16(u);
+            else if constexpr (sizeof(T) == 4) u = __builtin_bswap32(u);
+            else u = __builtin_bswap64(u);
+            std::memcpy(&v, &u, sizeof(T));
+            return v;
+        }
+    }
+};
+
+}  // namespace octiso
