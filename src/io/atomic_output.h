@@ -1,4 +1,5 @@
-// AtomicOutput: write to a temporary sibling ("NAME.tmp-PID"), rename onto NAME on commit(), remove
+// AtomicOutput: write to a temporary sibling (".tmp-PID-NAME", so the extension that picks the
+// image format survives), rename onto NAME on commit(), remove
 // the temporary in the destructor otherwise. Every octiso output file goes through it, so a failed
 // or interrupted run never leaves a partial file under the requested name (CONVENTIONS 3).
 #pragma once
@@ -14,7 +15,7 @@ namespace octiso {
 class AtomicOutput {
 public:
     explicit AtomicOutput(std::string path)
-        : path_(std::move(path)), temp_(path_ + ".tmp-" + std::to_string(::getpid())) {}
+        : path_(std::move(path)), temp_(temp_name(path_)) {}
     ~AtomicOutput() {
         if (!committed_) std::remove(temp_.c_str());
     }
@@ -30,6 +31,11 @@ public:
     }
 
 private:
+    static std::string temp_name(const std::string& path) {
+        const size_t slash = path.find_last_of('/');
+        const size_t base = slash == std::string::npos ? 0 : slash + 1;
+        return path.substr(0, base) + ".tmp-" + std::to_string(::getpid()) + "-" + path.substr(base);
+    }
     std::string path_, temp_;
     bool committed_ = false;
 };
