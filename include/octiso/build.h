@@ -37,17 +37,23 @@ struct BuildStats {
     double seconds = 0;
 };
 
+/// A fixed-size array whose elements start uninitialised, so that its pages become resident only
+/// as they are written (the builder's concatenation relies on that to keep peak memory low).
+template <typename U> struct UninitArray {
+    std::unique_ptr<U[]> data;
+    uint64_t size = 0;
+    static UninitArray make(uint64_t n) { return {std::unique_ptr<U[]>(new U[n]), n}; }
+};
+
 template <typename T> class OctreeData {
 public:
-    OctreeData() = default;
     Octree<T> view() const;
-    const BuildStats& stats() const { return stats_; }
 
     Dims dims;
     int dmax = 0;
-    std::vector<std::vector<InteriorNode<T>>> nodes;   ///< [depth 0 .. dmax-2]
-    std::vector<Cap<T>> caps;
-    BuildStats stats_;
+    std::vector<UninitArray<InteriorNode<T>>> nodes;   ///< [depth 0 .. dmax-2]
+    UninitArray<Cap<T>> caps;
+    BuildStats stats;
 };
 
 /// Builds the octree of `volume`. Throws Error(options.source_name, ...) on non-finite data

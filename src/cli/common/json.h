@@ -1,0 +1,136 @@
+// JsonWriter: the tiny streaming writer behind every --json report (CONVENTIONS 3: exactly one
+// JSON object on stdout). It tracks commas and nesting, escapes strings per RFC 8259, and writes
+// non-finite numbers as null, which JSON cannot express otherwise.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+namespace octiso::cli {
+
+/// Usage: JsonWriter j(std::cout); j.begin_object(); j.key("n").value(3); j.end_object();
+/// Keys are only legal directly inside an object, values after a key or inside an array; the
+/// writer does not police misuse beyond that, it is for our own reports.
+class JsonWriter {
+public:
+    explicit JsonWriter(std::ostream& out) : out_(out) {}
+
+    JsonWriter& begin_object() { return open('{'); }
+    JsonWriter& end_object() { return close('}'); }
+    JsonWriter& begin_array() { return open('['); }
+    JsonWriter& end_array() { return close(']'); }
+
+    JsonWriter& key(std::string_view k) {
+        separate();
+        write_string(k);
+        out_ << ':';
+        after_key_ = true;
+        return *this;
+    }
+
+    JsonWriter& value(std::string_view s) {
+        separate();
+        write_string(s);
+        return *this;
+    }
+    JsonWriter& value(const char* s) { return value(std::string_view(s)); }
+    JsonWriter& value(const std::string& s) { return value(std::string_view(s)); }
+    JsonWriter& value(bool b) {
+        separate();
+        out_ << (b ? "true" : "false");
+        return *this;
+    }
+    JsonWriter& null() {
+        separate();
+        out_ << "null";
+        return *this;
+    }
+    /// Integers exactly; floating point with 17 significant digits (round-trips), NaN/Inf as null.
+    template <typename N, std::enable_if_t<std::is_arithmetic_v<N> && !std::is_same_v<N, bool>, int> = 0>
+    JsonWriter& value(N v) {
+        separate();
+        if constexpr (std::is_integral_v<N>) {
+            if constexpr (std::is_signed_v<N>) out_ << static_cast<long long>(v);
+            else out_ << static_cast<unsigned long long>(v);
+        } else {
+            if (!std::isfinite(double(v))) {
+                out_ << "null";
+            } else {
+                char buf[32];
+                std::snprintf(buf, sizeof buf, "%.17g", double(v));
+                out_ << buf;
+            }
+        }
+        return *this;
+    }
+    /// key(k).value(v) in one call.
+    template <typename V> JsonWriter& field(std::string_view k, const V& v) { return key(k).value(v); }
+    /// An array of numbers or strings.
+    template <typename Seq> JsonWriter& array(const Seq& seq) {
+        begin_array();
+        for (const auto& v : seq) value(v);
+        return end_array();
+    }
+
+    /// Escapes `s` as the body of a JSON string (no quotes): ", \, and control characters.
+    static std::string escape(std::string_view s) {
+        std::string r;
+        r.reserve(s.size());
+        for (const char ch : s) {
+            const unsigned char c = static_cast<unsigned char>(ch);
+            switch (c) {
+                case '"': r += "\\\""; break;
+                case '\\': r += "\\\\"; break;
+                case '\b': r += "\\b"; break;
+                case '\f': r += "\\f"; break;
+                case '\n': r += "\\n"; break;
+                case '\r': r += "\\r"; break;
+                case '\t': r += "\\t"; break;
+                default:
+                    if (c < 0x20 || c == 0x7f) {
+                        char buf[8];
+                        std::snprintf(buf, sizeof buf, "\\u%04x", c);
+                        r += buf;
+                    } else {
+                        r += ch;   // UTF-8 bytes pass through unchanged
+                    }
+            }
+        }
+        return r;
+    }
+
+private:
+    JsonWriter& open(char c) {
+        separate();
+        out_ << c;
+        first_.push_back(true);
+        return *this;
+    }
+    JsonWriter& close(char c) {
+        if (!first_.empty()) first_.pop_back();
+        out_ << c;
+        return *this;
+    }
+    void separate() {
+        if (after_key_) {   // the value of a key: no comma
+            after_key_ = false;
+            return;
+        }
+        if (first_.empty()) return;
+        if (!first_.back()) out_ << ',';
+        first_.back() = false;
+    }
+    void write_string(std::string_view s) { out_ << '"' << escape(s) << '"'; }
+
+    std::ostream& out_;
+    std::vector<bool> first_;   // per open container: nothing written in it yet
+    bool after_key_ = false;
+};
+
+}  // namespace octiso::cli

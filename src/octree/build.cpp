@@ -1,0 +1,348 @@
+// Bottom-up octree construction (Knoll et al. 2006, Sec. 3.1, 3.3, 4.1) in parallel.
+//
+// Plan: 1. condition the input (prepare.h); 2. cut the tree at a split depth k into up to 8^k
+// subtrees ("pieces") and build each one depth-first in its own Sink, in parallel; 3. build the
+// few nodes above depth k serially from the pieces' root summaries; 4. concatenate each depth's
+// arrays, offsetting child_start by the children the earlier pieces contributed.
+//
+// Why depth-first post-order works: a node is appended to its depth's array when its own children
+// are complete, so the 8 children of any node are appended consecutively at depth d+1, which is
+// exactly what child_start + popcount indexing needs. A child is appended only if it is not a
+// scalar leaf, and a node merges into a leaf only if all its children are leaves, so a merge never
+// leaves orphans behind.
+//
+// Min/max (Sec. 3.3, Fig. 5): the cells whose lower corner lies in a 2x2x2 block use the voxels of
+// the 3x3x3 box from the block's origin, clipped to the data; higher levels take the union of their
+// children. A node at depth dmax-2 (4^3 voxels) loads its 5^3 neighbourhood once and derives the
+// ranges of its 8 blocks from it: about 2 reads per voxel instead of 27/8 per block voxel.
+// Padding beyond the data never enters a range and never blocks a merge ("don't care").
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "octiso/build.h"
+#include "octiso/error.h"
+#include "octree/prepare.h"
+
+namespace octiso {
+
+template <typename T> Octree<T> OctreeData<T>::view() const {
+    OctreeArrays<T> a;
+    a.dims = dims;
+    a.dmax = dmax;
+    for (size_t d = 0; d < nodes.size(); ++d) {
+        a.nodes[d] = nodes[d].data.get();
+        a.node_count[d] = nodes[d].size;
+    }
+    a.caps = caps.data.get();
+    a.cap_count = caps.size;
+    return Octree<T>(a);
+}
+
+namespace {
+
+/// What a finished subtree tells its parent.
+template <typename T> struct Summary {
+    T scalar;              ///< the value of a leaf; the midpoint of the data range otherwise
+    T cell_min, cell_max;  ///< range over the data cells with lower corner inside; empty: min > max
+    T data_lo, data_hi;    ///< range of the data voxels inside (meaningless when is_padding)
+    bool is_leaf;
+    bool is_padding;       ///< no data voxel inside at all
+};
+
+/// One piece's output: node records by absolute depth, caps, leaf counts by depth.
+template <typename T> struct Sink {
+    std::vector<std::vector<InteriorNode<T>>> nodes;
+    std::vector<Cap<T>> caps;
+    std::vector<uint64_t> leaves;
+    explicit Sink(int dmax) : nodes(size_t(dmax)), leaves(size_t(dmax), 0) {}
+};
+
+template <typename T> class Builder {
+public:
+    Builder(const VolumeView<T>& v, int dmax, double tolerance)
+        : v_(v), dims_(v.dims), dmax_(dmax), tolerance_(tolerance) {}
+
+    uint32_t child_bit(int d) const { return 1u << (dmax_ - d - 1); }
+
+    static Summary<T> padding() {
+        return {T{}, std::numeric_limits<T>::max(), std::numeric_limits<T>::lowest(), T{}, T{}, true, true};
+    }
+
+    bool outside(Coord o) const { return o.x >= dims_.x || o.y >= dims_.y || o.z >= dims_.z; }
+
+    static Coord child_origin(Coord o, int c, uint32_t half) {
+        return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
+    }
+
+    /// Whether values in [lo, hi] may become one value `rep` with |v - rep| <= tolerance for all.
+    bool mergeable(T lo, T hi, T& rep) const {
+        if (lo == hi) { rep = lo; return true; }
+        if (tolerance_ <= 0) return false;
+        const double a = double(lo), b = double(hi);
+        if (b - a > 2 * tolerance_) return false;
+        double m = a + (b - a) / 2;
+        if constexpr (!std::is_floating_point_v<T>) m = std::round(m);
+        const T r = T(m);
+        if (double(r) - a > tolerance_ || b - double(r) > tolerance_) return false;
+        rep = r;
+        return true;
+    }
+
+    static T midpoint(T lo, T hi) {
+        return T(double(lo) + (double(hi) - double(lo)) / 2);
+    }
+
+    /// Widening of a cell range by the tolerance, so that it also bounds the stored (lossy) values.
+    void widen(T& lo, T& hi) const {
+        if (tolerance_ <= 0 || lo > hi) return;
+        const double l = std::floor(double(lo) - tolerance_), h = std::ceil(double(hi) + tolerance_);
+        lo = l <= double(std::numeric_limits<T>::lowest()) ? std::numeric_limits<T>::lowest() : T(l);
+        hi = h >= double(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::max() : T(h);
+    }
+
+    /// Subtree of the node at depth d (d <= dmax-2) with origin o, into `sink`.
+    Summary<T> build(int d, Coord o, Sink<T>& sink) const {
+        if (outside(o)) return padding();
+        if (d == dmax_ - 2) return build_cap_parent(o, sink);
+        Summary<T> ch[8];
+        const uint64_t start = sink.nodes[size_t(d + 1)].size();
+        const uint32_t half = child_bit(d);
+        for (int c = 0; c < 8; ++c) ch[c] = build(d + 1, child_origin(o, c, half), sink);
+        return combine(d, ch, start, sink);
+    }
+
+    /// Folds 8 child summaries into a leaf, or stores an interior node at depth d.
+    /// `start` is the index the first stored child got at depth d+1 (local to the sink).
+    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, Sink<T>& sink) const {
+        bool all_leaves = true, any_data = false;
+        T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
+        T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
+        for (int c = 0; c < 8; ++c) {
+            all_leaves &= ch[c].is_leaf;
+            if (!ch[c].is_padding) {
+                any_data = true;
+                lo = std::min(lo, ch[c].data_lo);
+                hi = std::max(hi, ch[c].data_hi);
+            }
+            if (ch[c].cell_min <= ch[c].cell_max) {
+                cmin = std::min(cmin, ch[c].cell_min);
+                cmax = std::max(cmax, ch[c].cell_max);
+            }
+        }
+        // The root is always stored, so that every tree has an interior node at depth 0.
+        if (d > 0 && all_leaves) {
+            if (!any_data) return padding();
+            T rep;
+            if (mergeable(lo, hi, rep)) return {rep, cmin, cmax, lo, hi, true, false};
+        }
+        InteriorNode<T> n{};
+        uint8_t mask = 0;
+        for (int c = 0; c < 8; ++c) {
+            n.scalar[c] = ch[c].scalar;
+            n.min[c] = ch[c].cell_min;
+            n.max[c] = ch[c].cell_max;
+            if (!ch[c].is_leaf) mask = uint8_t(mask | (1u << c));
+        }
+        n.child_mask = mask;
+        n.child_start = uint32_t(start);   // local; offset and range-checked at concatenation
+        sink.nodes[size_t(d)].push_back(n);
+        sink.leaves[size_t(d)] += uint64_t(8 - std::popcount(unsigned(mask)));
+        return {any_data ? midpoint(lo, hi) : T{}, cmin, cmax, lo, hi, false, !any_data};
+    }
+
+    /// A node at depth dmax-2: 4^3 voxels in 8 blocks of 2^3, each a scalar leaf or a cap.
+    Summary<T> build_cap_parent(Coord o, Sink<T>& sink) const {
+        // 1. Load the 5^3 neighbourhood from o, coordinates clamped into the data. Clamped
+        //    positions replicate the border: they fill padding slots of caps and are never
+        //    counted in a range, because the extents below stop at the data.
+        T L[5][5][5];
+        uint32_t xs[5], ys[5], zs[5];
+        for (uint32_t i = 0; i < 5; ++i) {
+            xs[i] = std::min(o.x + i, dims_.x - 1);
+            ys[i] = std::min(o.y + i, dims_.y - 1);
+            zs[i] = std::min(o.z + i, dims_.z - 1);
+        }
+        for (int z = 0; z < 5; ++z)
+            for (int y = 0; y < 5; ++y) {
+                const uint64_t row = v_.index(0, ys[y], zs[z]);
+                for (int x = 0; x < 5; ++x) L[z][y][x] = v_.load(row + xs[x]);
+            }
+
+        // 2. Each block: data range over its data voxels, cell range over the 3^3 box.
+        Summary<T> ch[8];
+        const uint64_t start = sink.caps.size();
+        for (int c = 0; c < 8; ++c) {
+            const int bx = (c & 4) ? 2 : 0, by = (c & 2) ? 2 : 0, bz = (c & 1) ? 2 : 0;
+            const Coord g{o.x + uint32_t(bx), o.y + uint32_t(by), o.z + uint32_t(bz)};
+            if (outside(g)) { ch[c] = padding(); continue; }
+            const int ex = int(std::min<uint32_t>(2, dims_.x - g.x));
+            const int ey = int(std::min<uint32_t>(2, dims_.y - g.y));
+            const int ez = int(std::min<uint32_t>(2, dims_.z - g.z));
+            T lo = L[bz][by][bx], hi = lo;
+            for (int z = 0; z < ez; ++z)
+                for (int y = 0; y < ey; ++y)
+                    for (int x = 0; x < ex; ++x) {
+                        const T v = L[bz + z][by + y][bx + x];
+                        lo = std::min(lo, v);
+                        hi = std::max(hi, v);
+                    }
+            T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
+            if (dims_.x - g.x >= 2 && dims_.y - g.y >= 2 && dims_.z - g.z >= 2) {
+                const int cx = int(std::min<uint32_t>(3, dims_.x - g.x));
+                const int cy = int(std::min<uint32_t>(3, dims_.y - g.y));
+                const int cz = int(std::min<uint32_t>(3, dims_.z - g.z));
+                for (int z = 0; z < cz; ++z)
+                    for (int y = 0; y < cy; ++y)
+                        for (int x = 0; x < cx; ++x) {
+                            const T v = L[bz + z][by + y][bx + x];
+                            cmin = std::min(cmin, v);
+                            cmax = std::max(cmax, v);
+                        }
+                widen(cmin, cmax);
+            }
+            T rep;
+            if (mergeable(lo, hi, rep)) {
+                ch[c] = {rep, cmin, cmax, lo, hi, true, false};
+                continue;
+            }
+            Cap<T> cap;
+            for (int k = 0; k < 8; ++k) cap.voxel[k] = L[bz + (k & 1)][by + ((k >> 1) & 1)][bx + ((k >> 2) & 1)];
+            sink.caps.push_back(cap);
+            ch[c] = {midpoint(lo, hi), cmin, cmax, lo, hi, false, false};
+        }
+        return combine(dmax_ - 2, ch, start, sink);
+    }
+
+    const VolumeView<T> v_;
+    const Dims dims_;
+    const int dmax_;
+    const double tolerance_;
+};
+
+/// Appends `src` to `dst` at `at`, then frees `src`, so each piece's memory goes as it is copied.
+template <typename U> void move_into(UninitArray<U>& dst, uint64_t& at, std::vector<U>& src) {
+    std::copy(src.begin(), src.end(), dst.data.get() + at);
+    at += src.size();
+    std::vector<U>().swap(src);
+}
+
+template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const BuildOptions& options) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (input.dims.x == 0 || input.dims.y == 0 || input.dims.z == 0)
+        throw Error(options.source_name, "volume has a zero dimension");
+    detail::PreparedVolume<T> prepared = detail::prepare_volume(input, options);
+
+    OctreeData<T> out;
+    out.dims = input.dims;
+    out.dmax = dmax_for(input.dims);
+    const int dmax = out.dmax;
+    const Builder<T> builder(prepared.view, dmax, options.tolerance);
+
+    // 1. Pieces: the nodes at split depth k that the top-level descent reaches, in DFS order.
+    const int k = std::min(dmax - 2, 3);
+    std::vector<Coord> origins;
+    auto enumerate = [&](auto&& self, int d, Coord o) -> void {
+        if (builder.outside(o)) return;
+        if (d == k) { origins.push_back(o); return; }
+        for (int c = 0; c < 8; ++c) self(self, d + 1, Builder<T>::child_origin(o, c, builder.child_bit(d)));
+    };
+    enumerate(enumerate, 0, Coord{});
+
+    std::vector<Sink<T>> sinks;
+    sinks.reserve(origins.size());
+    for (size_t i = 0; i < origins.size(); ++i) sinks.emplace_back(dmax);
+    std::vector<Summary<T>> roots(origins.size());
+    tbb::parallel_for(size_t(0), origins.size(), [&](size_t i) { roots[i] = builder.build(k, origins[i], sinks[i]); });
+
+    // 2. The top: the same descent, taking each depth-k summary from its piece. A depth-(k-1)
+    //    node's child_start counts the piece roots stored before it.
+    Sink<T> top(dmax);
+    size_t next_piece = 0;
+    uint64_t stored_at_k = 0;
+    auto descend = [&](auto&& self, int d, Coord o) -> Summary<T> {
+        if (builder.outside(o)) return Builder<T>::padding();
+        if (d == k) {
+            const Summary<T>& s = roots[next_piece++];
+            if (!s.is_leaf) ++stored_at_k;
+            return s;
+        }
+        Summary<T> ch[8];
+        const uint64_t start = d + 1 == k ? stored_at_k : top.nodes[size_t(d + 1)].size();
+        for (int c = 0; c < 8; ++c) ch[c] = self(self, d + 1, Builder<T>::child_origin(o, c, builder.child_bit(d)));
+        return builder.combine(d, ch, start, top);
+    };
+    if (k > 0) descend(descend, 0, Coord{});
+
+    // 3. Concatenate depth by depth. Depths below k come from `top` alone.
+    out.nodes.resize(size_t(dmax - 1));
+    out.stats.nodes_per_depth.assign(size_t(dmax), 0);
+    out.stats.scalar_leaves_per_depth.assign(size_t(dmax), 0);
+    for (int d = 0; d <= dmax - 2; ++d) {
+        std::vector<Sink<T>*> parts;
+        if (d < k) parts.push_back(&top);
+        else for (auto& s : sinks) parts.push_back(&s);
+        uint64_t total = 0;
+        for (auto* p : parts) total += p->nodes[size_t(d)].size();
+        out.nodes[size_t(d)] = UninitArray<InteriorNode<T>>::make(total);
+        uint64_t at = 0, child_offset = 0;
+        for (auto* p : parts) {
+            auto& v = p->nodes[size_t(d)];
+            if (d >= k) {
+                for (auto& n : v) {
+                    const uint64_t global = uint64_t(n.child_start) + child_offset;
+                    if (global + uint64_t(std::popcount(unsigned(n.child_mask))) > (uint64_t(1) << 32))
+                        throw Error(options.source_name, "octree too large: more than 2^32 nodes at depth " +
+                                                             std::to_string(d + 1) + " (32-bit child indices)");
+                    n.child_start = uint32_t(global);
+                }
+                child_offset += d + 1 == dmax - 1 ? p->caps.size() : p->nodes[size_t(d + 1)].size();
+            }
+            out.stats.scalar_leaves_per_depth[size_t(d)] += p->leaves[size_t(d)];
+            move_into(out.nodes[size_t(d)], at, v);
+        }
+        out.stats.nodes_per_depth[size_t(d)] = total;
+    }
+    uint64_t n_caps = 0;
+    for (auto& s : sinks) n_caps += s.caps.size();
+    out.caps = UninitArray<Cap<T>>::make(n_caps);
+    uint64_t at = 0;
+    for (auto& s : sinks) move_into(out.caps, at, s.caps);
+    out.stats.nodes_per_depth[size_t(dmax - 1)] = n_caps;
+
+    for (int d = 0; d <= dmax - 2; ++d) out.stats.interior_bytes += out.nodes[size_t(d)].size * sizeof(InteriorNode<T>);
+    out.stats.minmax_bytes = out.stats.interior_bytes / sizeof(InteriorNode<T>) * 16 * sizeof(T);
+    out.stats.cap_bytes = n_caps * sizeof(Cap<T>);
+    out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+}
+
+}  // namespace
+
+template <typename T> OctreeData<T> build_octree(const VolumeView<T>& volume, const BuildOptions& options) {
+    if (options.threads > 0) {
+        tbb::task_arena arena(options.threads);
+        return arena.execute([&] { return build_impl(volume, options); });
+    }
+    return build_impl(volume, options);
+}
+
+#define OCTISO_INSTANTIATE(T)                                                               \
+    template class OctreeData<T>;                                                           \
+    template OctreeData<T> build_octree<T>(const VolumeView<T>&, const BuildOptions&);
+OCTISO_INSTANTIATE(uint8_t)
+OCTISO_INSTANTIATE(int8_t)
+OCTISO_INSTANTIATE(uint16_t)
+OCTISO_INSTANTIATE(int16_t)
+OCTISO_INSTANTIATE(uint32_t)
+OCTISO_INSTANTIATE(int32_t)
+OCTISO_INSTANTIATE(float)
+OCTISO_INSTANTIATE(double)
+#undef OCTISO_INSTANTIATE
+
+}  // namespace octiso

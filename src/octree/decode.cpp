@@ -1,0 +1,115 @@
+// decode_to_dense (decode.h): walks the octree once, filling each scalar leaf's block (clipped to
+// the data) with x-runs and each cap's 2x2x2 voxels, instead of one point location per voxel.
+// The top levels are expanded serially into disjoint subtrees that are then filled in parallel.
+#include "octiso/decode.h"
+
+#include <algorithm>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+namespace octiso {
+
+namespace {
+
+/// A piece of the cube: either a subtree rooted at node `index` of `depth`, or (depth < 0) a
+/// uniform block of `value`. `corner` is its lower corner, `side` its edge length in voxels.
+template <typename T> struct Piece {
+    int depth;
+    uint32_t index;
+    T value;
+    Coord corner;
+    uint32_t side;
+};
+
+template <typename T> class Decoder {
+public:
+    Decoder(const Octree<T>& o, T* out) : o_(o), out_(out), dims_(o.dims()) {}
+
+    void fill_block(Coord c, uint32_t side, T value) const {
+        if (c.x >= dims_.x || c.y >= dims_.y || c.z >= dims_.z) return;   // all padding
+        const uint32_t x1 = std::min<uint64_t>(uint64_t(c.x) + side, dims_.x);
+        const uint32_t y1 = std::min<uint64_t>(uint64_t(c.y) + side, dims_.y);
+        const uint32_t z1 = std::min<uint64_t>(uint64_t(c.z) + side, dims_.z);
+        for (uint32_t z = c.z; z < z1; ++z)
+            for (uint32_t y = c.y; y < y1; ++y) std::fill(out_ + index(c.x, y, z), out_ + index(x1, y, z), value);
+    }
+
+    void fill_cap(Coord c, const Cap<T>& cap) const {
+        for (int o = 0; o < 8; ++o) {
+            const uint32_t x = c.x + uint32_t(o >> 2), y = c.y + uint32_t((o >> 1) & 1), z = c.z + uint32_t(o & 1);
+            if (x < dims_.x && y < dims_.y && z < dims_.z) out_[index(x, y, z)] = cap.voxel[o];
+        }
+    }
+
+    /// Fills the subtree at node `index` of `depth` whose cube starts at `c`.
+    void fill_node(int depth, uint32_t index, Coord c) const {
+        if (c.x >= dims_.x || c.y >= dims_.y || c.z >= dims_.z) return;
+        if (depth == o_.cap_depth()) return fill_cap(c, o_.cap(index));
+        const InteriorNode<T>& n = o_.node(depth, index);
+        const uint32_t half = o_.child_bit(depth);
+        for (int ch = 0; ch < 8; ++ch) {
+            const Coord cc = child_corner(c, ch, half);
+            if (n.is_scalar_leaf(ch)) fill_block(cc, half, n.scalar[ch]);
+            else fill_node(depth + 1, n.child_index(ch), cc);
+        }
+    }
+
+    void fill(const Piece<T>& p) const {
+        if (p.depth < 0) fill_block(p.corner, p.side, p.value);
+        else fill_node(p.depth, p.index, p.corner);
+    }
+
+    static Coord child_corner(Coord c, int ch, uint32_t half) {
+        return {c.x + ((ch & 4) ? half : 0), c.y + ((ch & 2) ? half : 0), c.z + ((ch & 1) ? half : 0)};
+    }
+
+private:
+    uint64_t index(uint32_t x, uint32_t y, uint32_t z) const {
+        return uint64_t(x) + uint64_t(dims_.x) * (uint64_t(y) + uint64_t(dims_.y) * z);
+    }
+    const Octree<T>& o_;
+    T* out_;
+    Dims dims_;
+};
+
+}  // namespace
+
+template <typename T> void decode_to_dense(const Octree<T>& octree, T* out) {
+    const Decoder<T> dec(octree, out);
+    // Expand the top of the tree breadth-first until there are enough disjoint pieces to keep
+    // every core busy (or the caps are reached); pieces outside the data are dropped.
+    constexpr size_t kPieces = 512;
+    const Dims dims = octree.dims();
+    std::vector<Piece<T>> pieces{{0, 0, T{}, Coord{}, octree.side()}};
+    for (int d = 0; d < octree.cap_depth() && pieces.size() < kPieces; ++d) {
+        std::vector<Piece<T>> next;
+        for (const Piece<T>& p : pieces) {
+            if (p.depth != d) {
+                next.push_back(p);
+                continue;
+            }
+            const InteriorNode<T>& n = octree.node(d, p.index);
+            const uint32_t half = octree.child_bit(d);
+            for (int ch = 0; ch < 8; ++ch) {
+                const Coord cc = Decoder<T>::child_corner(p.corner, ch, half);
+                if (cc.x >= dims.x || cc.y >= dims.y || cc.z >= dims.z) continue;
+                if (n.is_scalar_leaf(ch)) next.push_back({-1, 0, n.scalar[ch], cc, half});
+                else next.push_back({d + 1, n.child_index(ch), T{}, cc, half});
+            }
+        }
+        pieces.swap(next);
+    }
+    tbb::parallel_for(size_t(0), pieces.size(), [&](size_t i) { dec.fill(pieces[i]); });
+}
+
+template void decode_to_dense<uint8_t>(const Octree<uint8_t>&, uint8_t*);
+template void decode_to_dense<int8_t>(const Octree<int8_t>&, int8_t*);
+template void decode_to_dense<uint16_t>(const Octree<uint16_t>&, uint16_t*);
+template void decode_to_dense<int16_t>(const Octree<int16_t>&, int16_t*);
+template void decode_to_dense<uint32_t>(const Octree<uint32_t>&, uint32_t*);
+template void decode_to_dense<int32_t>(const Octree<int32_t>&, int32_t*);
+template void decode_to_dense<float>(const Octree<float>&, float*);
+template void decode_to_dense<double>(const Octree<double>&, double*);
+
+}  // namespace octiso

@@ -1,0 +1,26 @@
+// Conditioning the input before the build: non-finite values (refused, or replaced with --nan-as)
+// and --iso-range clamping. Both return a view of the input itself when nothing changes, and make
+// one private copy only when values must change.
+#pragma once
+
+#include <vector>
+
+#include "octiso/build.h"
+
+namespace octiso::detail {
+
+template <typename T> struct PreparedVolume {
+    VolumeView<T> view;      ///< what the builder reads: the input, or `storage`
+    std::vector<T> storage;  ///< the modified copy, empty when the input is used as is
+    uint64_t clamped_voxels = 0;
+    uint64_t replaced_voxels = 0;
+};
+
+template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& input, const BuildOptions& options);
+
+/// The stored value that stands for "at or below LO" (resp. "at or above HI"): the largest T <= lo
+/// (smallest T >= hi), so a clamped voxel stays on the same side of every iso in (LO, HI).
+template <typename T> T clamp_target_low(double lo);
+template <typename T> T clamp_target_high(double hi);
+
+}  // namespace octiso::detail
