@@ -43,6 +43,11 @@ template <typename T> struct InteriorNode {
         return child_start + uint32_t(std::popcount(unsigned(child_mask) & ((1u << c) - 1u)));
     }
     bool may_contain(int c, double iso) const { return double(min[c]) <= iso && iso <= double(max[c]); }
+    bool may_contain_any(int c, const double* isos, int count) const {
+        for (int i = 0; i < count; ++i)
+            if (may_contain(c, isos[i])) return true;
+        return false;
+    }
 };
 
 /// Cap<T>: the 2x2x2 voxels of a node at depth dmax-1, octant order as above.

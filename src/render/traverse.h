@@ -1,0 +1,266 @@
+// OctreeTracer<T, Finder>: first hit of one ray with the isosurfaces of an Octree<T> (Knoll et al.
+// 2006, Sec. 4.3 and App. C), in index space on the closed data box [0, n-1]^3.
+//
+// Interior nodes: the ray's times at the three mid-planes decide the first child and the order
+// of the rest; a child is entered only if an isovalue lies in its [min, max]. Every plane time is
+// IndexRay::plane_t, the same expression the cell walk and the reference tracer use, so a ray
+// splits at exactly the same t at every level and no interval is lost or doubled.
+// Deviation from App. C: the first child is chosen by comparing times, not positions (no
+// position/time rounding mismatch), and +-0 direction components never divide (plane_t gives +inf).
+// Caps and scalar leaves: a short DDA over their cells. A scalar leaf's inner cells have all 8
+// corners equal to the leaf value, so unless an isovalue equals it only the shell of cells at its
+// +x/+y/+z faces (whose forward corners lie in neighbours) is walked.
+// Corners: inside a cap, a forward neighbour in the same cap is a direct read (octant & dir == 0),
+// otherwise neighbour finding climbs the parent trace this traversal keeps (App. B.2).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "octiso/octree.h"
+#include "octiso/render.h"
+#include "render/cell.h"
+#include "render/ray.h"
+#include "render/roots.h"
+
+namespace octiso {
+
+struct TraceHit {
+    double t = std::numeric_limits<double>::infinity();   ///< world distance; +inf: miss
+    std::array<double, 3> normal{0, 0, 0};
+    int iso_index = -1;
+    bool is_hit() const { return iso_index >= 0; }
+};
+
+template <typename T, class Finder> class OctreeTracer {
+public:
+    OctreeTracer(const Octree<T>& tree, const Placement& placement, const double* isovalues, int iso_count,
+                 const Finder& finder)
+        : tree_(tree), placement_(placement), iso_count_(iso_count), finder_(finder) {
+        for (int i = 0; i < iso_count; ++i) iso_[i] = isovalues[i];
+        const Dims d = tree.dims();
+        box_hi_ = {double(d.x) - 1, double(d.y) - 1, double(d.z) - 1};
+        has_cells_ = d.x >= 2 && d.y >= 2 && d.z >= 2;
+    }
+
+    /// First hit along the world ray; the normal is computed only if `want_normal`.
+    /// Thread-safe: all per-ray state lives on the caller's stack.
+    TraceHit trace(const Ray& ray_world, bool want_normal) const {
+        Walk w;
+        w.world_dir = ray_world.dir;
+        w.want_normal = want_normal;
+        if (!has_cells_) return w.hit;
+        w.ray = index_from_world(ray_world, placement_);
+        const BoxClip clip = clip_to_box(w.ray, box_hi_);
+        if (clip.empty()) return w.hit;
+        w.t_exit = clip.t_out;
+        node(w, 0, 0, Coord{}, clip.t_in, clip.t_out);
+        return w.hit;
+    }
+
+private:
+    struct Walk {
+        IndexRay ray;
+        std::array<double, 3> world_dir{};
+        double t_exit = 0;
+        bool want_normal = false;
+        uint32_t trace[kMaxDepth];
+        TraceHit hit;
+    };
+
+    bool any_iso_in(double lo, double hi) const {
+        for (int i = 0; i < iso_count_; ++i)
+            if (lo <= iso_[i] && iso_[i] <= hi) return true;
+        return false;
+    }
+
+    /// Whether the ray is on the upper side of the plane p[a] == plane at time t (the side it
+    /// occupies on [t, t + dt) for small dt): decided from times, never from positions.
+    static bool upper_at(const IndexRay& r, int a, double plane, double t_plane, double t) {
+        const double d = r.dir[a];
+        if (d > 0) return t_plane <= t;
+        if (d < 0) return t < t_plane;
+        return r.origin[a] >= plane;
+    }
+
+    bool node(Walk& w, int d, uint32_t index, Coord o, double t0, double t1) const {
+        w.trace[d] = index;
+        const InteriorNode<T>& n = tree_.node(d, index);
+        const uint32_t half = tree_.child_bit(d);
+        const uint32_t origin[3] = {o.x, o.y, o.z};
+        double tm[3];
+        int c = 0;
+        for (int a = 0; a < 3; ++a) {
+            const double mid = double(origin[a] + half);
+            tm[a] = w.ray.plane_t(a, mid);
+            if (upper_at(w.ray, a, mid, tm[a], t0)) c |= 4 >> a;
+        }
+        // Axes in the order the ray crosses their mid-planes (a 3-element sorting network).
+        int order[3] = {0, 1, 2};
+        if (tm[order[1]] < tm[order[0]]) std::swap(order[0], order[1]);
+        if (tm[order[2]] < tm[order[1]]) std::swap(order[1], order[2]);
+        if (tm[order[1]] < tm[order[0]]) std::swap(order[0], order[1]);
+
+        double t_cur = t0;
+        for (int i = 0; i <= 3; ++i) {
+            double t_next = t1;
+            if (i < 3 && tm[order[i]] > t0 && tm[order[i]] < t1) t_next = tm[order[i]];
+            else if (i < 3) continue;   // this axis is not crossed inside [t0, t1)
+            if (t_next > t_cur && n.may_contain_any(c, iso_, iso_count_)) {
+                const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
+                bool hit;
+                if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, d, co, half, n.scalar[c], t_cur, t_next);
+                else if (d == tree_.dmax() - 2) hit = cap(w, n.child_index(c), co, t_cur, t_next);
+                else hit = node(w, d + 1, n.child_index(c), co, t_cur, t_next);
+                if (hit) return true;
+            }
+            if (i == 3) break;
+            t_cur = std::max(t_cur, t_next);
+            c ^= 4 >> order[i];
+        }
+        return false;
+    }
+
+    bool cap(Walk& w, uint32_t cap_index, Coord co, double t0, double t1) const {
+        w.trace[tree_.dmax() - 1] = cap_index;
+        const Cap<T>& cap = tree_.cap(cap_index);
+        return walk_cells(w, co, 2, t0, t1, [&](Coord v, double corner[8]) {
+            const int oct = int(((v.x - co.x) << 2) | ((v.y - co.y) << 1) | (v.z - co.z));
+            for (int k = 0; k < 8; ++k) {
+                const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
+                if ((oct & dir) == 0) {
+                    corner[k] = double(cap.voxel[oct | dir]);
+                } else {
+                    const Coord dest{v.x + (k & 1), v.y + ((k >> 1) & 1), v.z + ((k >> 2) & 1)};
+                    corner[k] = double(tree_.neighbour_find(v, dest, tree_.dmax() - 1, w.trace));
+                }
+            }
+        });
+    }
+
+    bool scalar_leaf(Walk& w, int holder_depth, Coord co, uint32_t side, T value, double t0, double t1) const {
+        const double v = double(value);
+        auto gather = [&](Coord p, double corner[8]) {
+            const uint32_t ex = co.x + side, ey = co.y + side, ez = co.z + side;
+            for (int k = 0; k < 8; ++k) {
+                const Coord dest{p.x + (k & 1), p.y + ((k >> 1) & 1), p.z + ((k >> 2) & 1)};
+                corner[k] = (dest.x < ex && dest.y < ey && dest.z < ez)
+                                ? v
+                                : double(tree_.neighbour_find(p, dest, holder_depth, w.trace));
+            }
+        };
+        bool iso_equals_value = false;
+        for (int i = 0; i < iso_count_; ++i) iso_equals_value |= iso_[i] == v;
+        if (iso_equals_value) return walk_cells(w, co, side, t0, t1, gather);
+
+        // Skip the inner cells [co, co + side - 1)^3: constant, never crossed by another iso.
+        double ti0 = t0, ti1 = t1;
+        const uint32_t lo[3] = {co.x, co.y, co.z};
+        for (int a = 0; a < 3; ++a) {
+            const double p0 = double(lo[a]), p1 = double(lo[a] + side - 1);
+            const double d = w.ray.dir[a];
+            if (d == 0) {
+                if (w.ray.origin[a] < p0 || w.ray.origin[a] >= p1) ti1 = ti0 - 1;   // never inside
+                continue;
+            }
+            const double ta = w.ray.plane_t(a, d > 0 ? p0 : p1), tb = w.ray.plane_t(a, d > 0 ? p1 : p0);
+            ti0 = std::max(ti0, ta);
+            ti1 = std::min(ti1, tb);
+        }
+        if (!(ti0 < ti1)) return walk_cells(w, co, side, t0, t1, gather);
+        if (ti0 > t0 && walk_cells(w, co, side, t0, ti0, gather)) return true;
+        return ti1 < t1 && walk_cells(w, co, side, ti1, t1, gather);
+    }
+
+    /// DDA over the cells of the box [lo, lo + side)^3 that the ray crosses on [t0, t1), in order.
+    /// Each data cell gets the half-open piece [t_in, t_out) (closed at the data exit); `gather`
+    /// fills its 8 corners. Returns true at the first hit.
+    template <class Gather>
+    bool walk_cells(Walk& w, Coord lo, uint32_t side, double t0, double t1, Gather&& gather) const {
+        const IndexRay& r = w.ray;
+        const uint32_t box_lo[3] = {lo.x, lo.y, lo.z};
+        const Dims dims = tree_.dims();
+        const uint32_t last_cell[3] = {dims.x - 2, dims.y - 2, dims.z - 2};
+        int64_t cell[3];
+        for (int a = 0; a < 3; ++a) {
+            const double p = r.origin[a] + t0 * r.dir[a];
+            int64_t i = int64_t(std::floor(p));
+            const int64_t b0 = box_lo[a], b1 = int64_t(box_lo[a]) + side - 1;
+            i = std::clamp(i, b0, b1);
+            // Settle rounding of p at a cell face with the same plane times the DDA steps on.
+            if (r.dir[a] > 0) {
+                if (i < b1 && r.plane_t(a, double(i + 1)) <= t0) ++i;
+                else if (i > b0 && r.plane_t(a, double(i)) > t0) --i;
+            } else if (r.dir[a] < 0) {   // cell i holds [plane_t(i+1), plane_t(i))
+                if (i > b0 && r.plane_t(a, double(i)) <= t0) --i;
+                else if (i < b1 && r.plane_t(a, double(i + 1)) > t0) ++i;
+            }
+            cell[a] = i;
+        }
+        double t_cur = t0;
+        double corner[8];
+        for (;;) {
+            double t_face[3];
+            for (int a = 0; a < 3; ++a)
+                t_face[a] = r.dir[a] > 0 ? r.plane_t(a, double(cell[a] + 1))
+                          : r.dir[a] < 0 ? r.plane_t(a, double(cell[a]))
+                                         : std::numeric_limits<double>::infinity();
+            int axis = 0;
+            if (t_face[1] < t_face[axis]) axis = 1;
+            if (t_face[2] < t_face[axis]) axis = 2;
+            const double t_out = std::min(t_face[axis], t1);
+            const bool in_data = cell[0] <= last_cell[0] && cell[1] <= last_cell[1] && cell[2] <= last_cell[2];
+            const bool closed_end = t_out == w.t_exit;
+            if (in_data && (t_out > t_cur || closed_end)) {
+                const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
+                gather(v, corner);
+                if (test_cell(w, v, corner, t_cur, t_out, closed_end)) return true;
+            }
+            if (t_face[axis] >= t1) return false;
+            t_cur = std::max(t_cur, t_face[axis]);
+            cell[axis] += r.dir[axis] > 0 ? 1 : -1;
+            if (cell[axis] < int64_t(box_lo[axis]) || cell[axis] >= int64_t(box_lo[axis]) + side) return false;
+        }
+    }
+
+    bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
+        double lo = corner[0], hi = corner[0];
+        for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
+        if (!any_iso_in(lo, hi)) return false;   // also rejects NaN corners: every compare is false
+        // Cell-local endpoints from the integer cell index plus a double offset (notes E11).
+        const std::array<double, 3> o_cell{w.ray.origin[0] - double(v.x), w.ray.origin[1] - double(v.y),
+                                           w.ray.origin[2] - double(v.z)};
+        std::array<double, 3> p_in, p_out;
+        for (int a = 0; a < 3; ++a) {
+            p_in[a] = o_cell[a] + t_in * w.ray.dir[a];
+            p_out[a] = o_cell[a] + t_out * w.ray.dir[a];
+        }
+        double best_s = 2.0;
+        int best = -1;
+        for (int i = 0; i < iso_count_; ++i) {
+            if (!(lo <= iso_[i] && iso_[i] <= hi)) continue;
+            const double s = first_root(finder_, corner, iso_[i], p_in, p_out, closed_end);
+            if (s >= 0 && s < best_s) best_s = s, best = i;
+        }
+        if (best < 0) return false;
+        w.hit.t = t_in + best_s * (t_out - t_in);
+        w.hit.iso_index = best;
+        if (w.want_normal) {
+            std::array<double, 3> p_hit;
+            for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + best_s * (p_out[a] - p_in[a]);
+            w.hit.normal = world_normal(corner, p_hit, placement_.spacing, w.world_dir);
+        }
+        return true;
+    }
+
+    const Octree<T> tree_;   // a view: cheap to copy, and no dangling reference to a temporary
+    const Placement placement_;
+    double iso_[kMaxIsovalues] = {};
+    int iso_count_;
+    const Finder finder_;
+    std::array<double, 3> box_hi_{};
+    bool has_cells_ = false;
+};
+
+}  // namespace octiso

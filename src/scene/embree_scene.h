@@ -1,0 +1,39 @@
+// EmbreeVolumeScene: an Embree 3 scene with one user geometry per volume, whose bounds are the
+// volume's data box in world space and whose intersect callback runs the octree traversal.
+// Primary rays go through rtcIntersect1. Embree's RTCRay holds floats, so the exact double ray
+// travels beside it in an extended intersect context; the callback traces that one, and the
+// Embree and direct paths return bit-identical hits.
+#pragma once
+
+#include <array>
+#include <memory>
+
+#include "render/traverse.h"
+
+namespace octiso {
+
+/// The double-precision ray and the full hit record, carried through Embree to the callback.
+struct ExactRayContext;
+
+class EmbreeVolumeScene {
+public:
+    /// A function that traces `ray` and returns the hit; `user` is the traced object.
+    using TraceFn = TraceHit (*)(const void* user, const Ray& ray, bool want_normal);
+
+    EmbreeVolumeScene();
+    ~EmbreeVolumeScene();
+    EmbreeVolumeScene(const EmbreeVolumeScene&) = delete;
+    EmbreeVolumeScene& operator=(const EmbreeVolumeScene&) = delete;
+
+    /// Adds a volume whose world bounds are [lo, hi]; `user` must outlive the scene.
+    void add_volume(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const void* user, TraceFn trace);
+    void commit();
+    /// First hit of `ray` (world, unit direction) over all geometries. Thread-safe after commit().
+    TraceHit intersect(const Ray& ray, bool want_normal) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace octiso

@@ -1,0 +1,255 @@
+// The octree renderer against the dense brute-force tracer with exact roots (the ground truth):
+// synthetic fields, every scalar type, odd shapes, anisotropic spacing, cameras from all octants,
+// exactly axis-aligned rays, an eye inside the data, grazing views; plus the crack test.
+#include <cmath>
+#include <random>
+
+#include "octiso/build.h"
+#include "octiso/render.h"
+#include "octree/octree_test_util.h"
+#include "reference/brute_force.h"
+#include "render/camera.h"
+
+namespace octiso::test {
+namespace {
+
+enum class Field { Sphere, MarschnerLobb, Noise, Sierpinski, Torus };
+
+/// Fields with values in [0, 120] (so every type, i8 included, holds them), rounded for integer types.
+template <typename T> DenseVolume<T> make_field(Field field, Dims dims, uint32_t seed = 1) {
+    DenseVolume<T> v{dims, std::vector<T>(dims.voxels())};
+    std::mt19937 rng(seed);
+    std::vector<double> lattice(512);
+    for (double& x : lattice) x = std::uniform_real_distribution<double>(0, 255)(rng);
+    for (uint32_t z = 0; z < dims.z; ++z)
+        for (uint32_t y = 0; y < dims.y; ++y)
+            for (uint32_t x = 0; x < dims.x; ++x) {
+                const double u = (x + 0.5) / dims.x * 2 - 1, w = (y + 0.5) / dims.y * 2 - 1, q = (z + 0.5) / dims.z * 2 - 1;
+                double f = 0;
+                switch (field) {
+                    case Field::Sphere: f = 255 * (1 - std::sqrt(u * u + w * w + q * q) / std::sqrt(3.0)); break;
+                    case Field::MarschnerLobb: {
+                        const double r = std::sqrt(u * u + w * w);
+                        const double rho = std::cos(2 * M_PI * 6 * std::cos(M_PI * r / 2));
+                        f = 255 * (1 - std::sin(M_PI * q / 2) + 0.25 * (1 + rho)) / (2 * 1.25);
+                        break;
+                    }
+                    case Field::Noise: f = lattice[(x * 73856093u ^ y * 19349663u ^ z * 83492791u) % 512]; break;
+                    case Field::Sierpinski: {
+                        uint32_t a = x, b = y, c = z;
+                        bool hole = false;
+                        while (a || b || c) {
+                            hole |= ((a % 3 == 1) + (b % 3 == 1) + (c % 3 == 1)) >= 2;
+                            a /= 3, b /= 3, c /= 3;
+                        }
+                        f = hole ? 0 : 255;
+                        break;
+                    }
+                    case Field::Torus: {
+                        const double ring = std::sqrt(u * u + w * w) - 0.55;
+                        f = 255 * std::clamp(1 - std::sqrt(ring * ring + q * q) / 0.6, 0.0, 1.0);
+                        break;
+                    }
+                }
+                f *= 120.0 / 255.0;
+                if constexpr (!std::is_floating_point_v<T>) f = std::round(f);
+                v.values[x + uint64_t(dims.x) * (y + uint64_t(dims.y) * z)] = T(f);
+            }
+    return v;
+}
+
+struct Agreement {
+    uint64_t pixels = 0, mask_mismatch = 0, both = 0;
+    std::vector<double> depth_err;   // voxel units
+    double p99() {
+        if (depth_err.empty()) return 0;
+        std::sort(depth_err.begin(), depth_err.end());
+        return depth_err[std::min(depth_err.size() - 1, size_t(0.99 * double(depth_err.size())))];
+    }
+};
+
+template <typename T>
+Agreement compare_with_reference(const DenseVolume<T>& v, const Placement& placement, const Camera& camera, double iso,
+                                 bool use_embree = false) {
+    const auto data = build_octree(v.view(), {});
+    RenderOptions options;
+    options.isovalues = {iso};
+    options.want_colour = false;
+    options.want_depth = true;
+    options.use_embree = use_embree;
+    const Frame frame = render(data.view(), placement, camera, options);
+    const PinholeCamera pinhole(camera);
+    const double voxel = std::min({placement.spacing[0], placement.spacing[1], placement.spacing[2]});
+    Agreement a;
+    for (int py = 0; py < camera.height; ++py)
+        for (int px = 0; px < camera.width; ++px) {
+            const RefHit ref = trace_reference(v.view(), placement, pinhole.ray(px, py), iso);
+            const float t = frame.depth[size_t(py) * camera.width + px];
+            const bool hit = std::isfinite(t);
+            ++a.pixels;
+            if (hit != ref.is_hit()) ++a.mask_mismatch;
+            else if (hit) a.depth_err.push_back(std::abs(double(t) - ref.t) / voxel);
+        }
+    a.both = a.depth_err.size();
+    return a;
+}
+
+Camera look_at(std::array<double, 3> eye, std::array<double, 3> look, std::array<double, 3> up, double fov, int size) {
+    Camera c;
+    c.eye = eye, c.look = look, c.up = up, c.fov_deg = fov, c.width = c.height = size;
+    return c;
+}
+
+void expect_agreement(Agreement a, const std::string& what) {
+    SCOPED_TRACE(what);
+    EXPECT_LE(double(a.mask_mismatch), 0.0005 * double(a.pixels)) << a.mask_mismatch << " of " << a.pixels << " pixels differ";
+    // float depth output: allow its own rounding (2^-24 relative) on top of 1e-3 voxel
+    EXPECT_LE(a.p99(), 1e-3) << "depth p99 in voxels";
+    EXPECT_GT(a.both, 0u) << "the view must actually show the surface";
+}
+
+template <typename T> class RenderAgreement : public ::testing::Test {};
+TYPED_TEST_SUITE(RenderAgreement, AllScalarTypes);
+
+TYPED_TEST(RenderAgreement, SphereFromAllEightOctants) {
+    using T = TypeParam;
+    const Dims dims{23, 19, 26};
+    const auto v = make_field<T>(Field::Sphere, dims);
+    Placement placement;
+    const std::array<double, 3> centre{11, 9, 12.5};
+    for (int o = 0; o < 8; ++o) {
+        const std::array<double, 3> eye{centre[0] + ((o & 1) ? 40 : -40), centre[1] + ((o & 2) ? 35 : -35),
+                                        centre[2] + ((o & 4) ? 45 : -45)};
+        expect_agreement(compare_with_reference(v, placement, look_at(eye, centre, {0, 0, 1}, 35, 48), 70.0),
+                         "octant " + std::to_string(o));
+    }
+}
+
+TYPED_TEST(RenderAgreement, MarschnerLobbAnisotropicWithEmbree) {
+    using T = TypeParam;
+    const auto v = make_field<T>(Field::MarschnerLobb, {33, 33, 33});
+    Placement placement;
+    placement.spacing = {1.0, 0.7, 1.6};
+    placement.origin = {-3, 2, 5};
+    const Camera cam = look_at({60, -40, 70}, {13, 13.2, 30}, {0, 0, 1}, 40, 56);
+    expect_agreement(compare_with_reference(v, placement, cam, 60.0, true), "embree path");
+}
+
+TEST(RenderAgreementFields, NoiseSierpinskiTorusOddShapes) {
+    const struct { Field field; Dims dims; double iso; } cases[] = {
+        {Field::Noise, {17, 21, 13}, 56.0}, {Field::Sierpinski, {27, 27, 27}, 60.0},
+        {Field::Torus, {40, 31, 9}, 47.0},  {Field::Sphere, {2, 2, 2}, 5.0}, {Field::Sphere, {65, 33, 17}, 85.0}};
+    for (const auto& c : cases) {
+        const auto v = make_field<float>(c.field, c.dims);
+        Placement placement;
+        const std::array<double, 3> centre{c.dims.x / 2.0, c.dims.y / 2.0, c.dims.z / 2.0};
+        const double r = 1.6 * std::max({c.dims.x, c.dims.y, c.dims.z});
+        for (const auto& eye : {std::array<double, 3>{centre[0] + r, centre[1] - 0.7 * r, centre[2] + 0.5 * r},
+                                std::array<double, 3>{centre[0] - 0.3 * r, centre[1] + r, centre[2] - 0.8 * r}}) {
+            Agreement a = compare_with_reference(v, placement, look_at(eye, centre, {0, 0, 1}, 40, 48), c.iso);
+            SCOPED_TRACE(::testing::Message() << "field " << int(c.field));
+            EXPECT_LE(double(a.mask_mismatch), 0.0005 * double(a.pixels)) << a.mask_mismatch;
+            EXPECT_LE(a.p99(), 1e-3);
+        }
+    }
+}
+
+TEST(RenderAgreementCameras, AxisAlignedInsideAndGrazing) {
+    const Dims dims{24, 24, 24};
+    const auto v = make_field<uint8_t>(Field::Torus, dims);
+    Placement placement;
+    const std::array<double, 3> c{11.5, 11.5, 11.5};
+    // Exactly axis-aligned views: the centre pixel rays have +-0 components. Even sizes put pixel
+    // centres off the axis, odd sizes put the middle ray exactly on it.
+    const Camera cams[] = {
+        look_at({c[0], c[1], 80}, c, {0, 1, 0}, 30, 49),     look_at({c[0], c[1], -80}, c, {0, 1, 0}, 30, 49),
+        look_at({80, c[1], c[2]}, c, {0, 0, 1}, 30, 49),     look_at({-80, c[1], c[2]}, c, {0, 0, 1}, 30, 48),
+        look_at({c[0], 80, c[2]}, c, {0, 0, 1}, 30, 49),     look_at({c[0], -80, 12}, {c[0], 0, 12}, {0, 0, 1}, 30, 49),
+        // eye inside the data, on mid-planes of the octree (8 and 16 are node boundaries)
+        look_at({8, 16, 12}, {20, 4, 12}, {0, 0, 1}, 70, 48), look_at({12, 12, 12}, {12, 30, 12}, {0, 0, 1}, 90, 48),
+        // grazing: eye level with the top face of the data box, looking along it
+        look_at({-30, 11.5, 23}, {30, 11.5, 23}, {0, 0, 1}, 20, 48),
+        look_at({-30, -30, 0}, {30, 30, 0}, {0, 0, 1}, 25, 48)};
+    int i = 0;
+    for (const Camera& cam : cams) {
+        Agreement a = compare_with_reference(v, placement, cam, 42.0);
+        SCOPED_TRACE("camera " + std::to_string(i++));
+        EXPECT_LE(double(a.mask_mismatch), 0.0005 * double(a.pixels)) << a.mask_mismatch << " of " << a.pixels;
+        EXPECT_LE(a.p99(), 1e-3);
+    }
+}
+
+TEST(RenderCracks, ClosedSurfaceFromFiftyRandomViewpointsHasNoHoles) {
+    // A closed isosurface (the sphere lies wholly inside the data). A crack is a pixel where the
+    // reference hits and octiso misses although all 4 neighbours hit in the reference (so it is
+    // not a silhouette pixel).
+    const Dims dims{28, 28, 28};
+    const auto v = make_field<uint16_t>(Field::Sphere, dims);
+    const auto data = build_octree(v.view(), {});
+    Placement placement;
+    std::mt19937 rng(2024);
+    std::normal_distribution<double> g;
+    const int size = 40;
+    uint64_t cracks = 0, checked = 0;
+    for (int view = 0; view < 50; ++view) {
+        std::array<double, 3> dir{g(rng), g(rng), g(rng)};
+        const double len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        const std::array<double, 3> c{13.5, 13.5, 13.5};
+        const double dist = std::uniform_real_distribution<double>(30, 70)(rng);
+        const Camera cam = look_at({c[0] + dir[0] / len * dist, c[1] + dir[1] / len * dist, c[2] + dir[2] / len * dist}, c,
+                                   std::abs(dir[2] / len) > 0.9 ? std::array<double, 3>{0, 1, 0} : std::array<double, 3>{0, 0, 1},
+                                   35, size);
+        RenderOptions options;
+        options.isovalues = {56.0};
+        options.want_colour = false;
+        options.want_depth = true;
+        const Frame frame = render(data.view(), placement, cam, options);
+        const PinholeCamera pinhole(cam);
+        std::vector<char> ref_hit(size * size);
+        for (int py = 0; py < size; ++py)
+            for (int px = 0; px < size; ++px) ref_hit[py * size + px] = trace_reference(v.view(), placement, pinhole.ray(px, py), 56.0).is_hit();
+        for (int py = 1; py + 1 < size; ++py)
+            for (int px = 1; px + 1 < size; ++px) {
+                const int i = py * size + px;
+                if (!(ref_hit[i] && ref_hit[i - 1] && ref_hit[i + 1] && ref_hit[i - size] && ref_hit[i + size])) continue;
+                ++checked;
+                cracks += !std::isfinite(frame.depth[i]);
+            }
+    }
+    EXPECT_EQ(cracks, 0u);
+    EXPECT_GT(checked, 5000u);
+}
+
+TEST(RenderPaths, EmbreeAndDirectGiveIdenticalFrames) {
+    const auto v = make_field<int16_t>(Field::MarschnerLobb, {30, 30, 30});
+    const auto data = build_octree(v.view(), {});
+    Placement placement;
+    RenderOptions options;
+    options.isovalues = {47.0, 85.0};
+    options.want_depth = options.want_normal = true;
+    const Camera cam = frame_data_box(v.dims, placement, 64, 48);
+    options.use_embree = true;
+    const Frame a = render(data.view(), placement, cam, options);
+    options.use_embree = false;
+    const Frame b = render(data.view(), placement, cam, options);
+    EXPECT_EQ(a.rgb, b.rgb);
+    EXPECT_EQ(a.normal, b.normal);
+    ASSERT_EQ(a.depth.size(), b.depth.size());
+    for (size_t i = 0; i < a.depth.size(); ++i) ASSERT_TRUE(a.depth[i] == b.depth[i] || (std::isinf(a.depth[i]) && std::isinf(b.depth[i])));
+    EXPECT_GT(a.stats.hits, 100u);
+}
+
+TEST(RenderNothingOutsideData, PaddingNeverDrawsASurface) {
+    // A volume of value 200 everywhere, iso 100: the padding of the power-of-two tree (and the
+    // paper's "zero outside") would draw the data box's faces; the contract says nothing is drawn.
+    DenseVolume<uint8_t> v{{10, 7, 5}, std::vector<uint8_t>(350, 200)};
+    const auto data = build_octree(v.view(), {});
+    RenderOptions options;
+    options.isovalues = {100.0};
+    options.want_depth = true;
+    const Frame f = render(data.view(), Placement{}, frame_data_box(v.dims, Placement{}, 32, 32), options);
+    EXPECT_EQ(f.stats.hits, 0u);
+}
+
+}  // namespace
+}  // namespace octiso::test
