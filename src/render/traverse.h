@@ -224,6 +224,16 @@ private:
         }
     }
 
+    /// A coordinate that rounding left a hair off a cell face is put exactly on it, so that two
+    /// cells sharing that face evaluate bitwise the same value there (cell.h) and the half-open
+    /// rule reports a root on the face exactly once.
+    static double snap_to_face(double p) {
+        constexpr double kEps = 1e-12;
+        if (std::fabs(p) < kEps) return 0.0;
+        if (std::fabs(p - 1.0) < kEps) return 1.0;
+        return p;
+    }
+
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
         double lo = corner[0], hi = corner[0];
         for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
@@ -233,8 +243,8 @@ private:
                                            w.ray.origin[2] - double(v.z)};
         std::array<double, 3> p_in, p_out;
         for (int a = 0; a < 3; ++a) {
-            p_in[a] = o_cell[a] + t_in * w.ray.dir[a];
-            p_out[a] = o_cell[a] + t_out * w.ray.dir[a];
+            p_in[a] = snap_to_face(o_cell[a] + t_in * w.ray.dir[a]);
+            p_out[a] = snap_to_face(o_cell[a] + t_out * w.ray.dir[a]);
         }
         double best_s = 2.0;
         int best = -1;

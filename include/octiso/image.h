@@ -1,0 +1,32 @@
+// Image files through OpenImageIO (CONVENTIONS 2): the format follows the extension; colour is
+// 8-bit sRGB unless the format is floating point; the depth AOV is one float channel named Z; the
+// normal AOV three float channels R,G,B. Every write goes to a temporary name renamed on success.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "octiso/render.h"
+
+namespace octiso {
+
+/// Writes frame.rgb. Throws Error(path, ...) if the format is unknown or the write fails.
+void write_colour_image(const std::string& path, const Frame& frame);
+/// Writes frame.depth as channel "Z" (+inf on a miss where the format allows, else a large value).
+void write_depth_image(const std::string& path, const Frame& frame);
+/// Writes frame.normal as float R,G,B.
+void write_normal_image(const std::string& path, const Frame& frame);
+
+/// Checks before rendering that OpenImageIO can write `path` (known extension), so a long render
+/// never ends in an unwritable file. Throws Error(flag, ...).
+void check_image_path(const std::string& path, const std::string& flag);
+
+/// A float image read back (tests, comparisons): width x height x channels, row 0 at the top.
+struct FloatImage {
+    int width = 0, height = 0, channels = 0;
+    std::vector<std::string> channel_names;
+    std::vector<float> pixels;
+};
+FloatImage read_image(const std::string& path);
+
+}  // namespace octiso

@@ -1,0 +1,283 @@
+// OctFile: maps a .oct file read-only, validates header and section table at open (cheap, all of
+// it), and each step's sections on first use (checksums, then every index; validate.cpp). Steps
+// are handed out as zero-copy Octree<T> views into the mapping.
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "format/oct_layout.h"
+#include "format/validate.h"
+#include "octiso/error.h"
+#include "octiso/oct_file.h"
+
+namespace octiso {
+
+using format::FileHeader;
+using format::SectionEntry;
+
+namespace {
+
+struct StepState {
+    std::once_flag once;
+    StepSizes sizes;   // written once inside call_once, read-only afterwards
+};
+
+std::string num(uint64_t v) { return std::to_string(v); }
+
+bool all_zero(const std::byte* p, uint64_t n) {
+    for (uint64_t i = 0; i < n; ++i)
+        if (p[i] != std::byte{0}) return false;
+    return true;
+}
+
+}  // namespace
+
+struct OctFile::Impl {
+    std::string path;
+    Verify verify = Verify::Full;
+    const std::byte* base = nullptr;   // the whole file, mapped read-only
+    uint64_t bytes = 0;
+    OctInfo info;
+    const SectionEntry* table = nullptr;   // step_count * dmax entries, (step, depth) order
+    std::unique_ptr<StepState[]> steps;
+
+    ~Impl() {
+        if (base) ::munmap(const_cast<std::byte*>(base), size_t(bytes));
+    }
+
+    [[noreturn]] void fail(const std::string& problem) const { throw Error(path, problem); }
+
+    const SectionEntry& section(uint32_t step, int depth) const {
+        return table[uint64_t(step) * uint64_t(info.dmax) + uint64_t(depth)];
+    }
+
+    void map_file();
+    void check_header();
+    void check_table();
+
+    template <typename T> OctreeArrays<T> arrays(uint32_t k) const {
+        OctreeArrays<T> a;
+        a.dims = info.dims;
+        a.dmax = info.dmax;
+        for (int d = 0; d + 1 < info.dmax; ++d) {
+            const SectionEntry& s = section(k, d);
+            a.nodes[size_t(d)] = reinterpret_cast<const InteriorNode<T>*>(base + s.offset);
+            a.node_count[size_t(d)] = s.count;
+        }
+        const SectionEntry& c = section(k, info.dmax - 1);
+        a.caps = reinterpret_cast<const Cap<T>*>(base + c.offset);
+        a.cap_count = c.count;
+        return a;
+    }
+
+    /// Validates step k exactly once (std::call_once: concurrent first callers wait; a failed
+    /// validation throws to every caller and is retried by the next one).
+    const StepSizes& ensure_valid(uint32_t k) const {
+        if (k >= info.step_count)
+            fail("step " + num(k) + " does not exist (expected 0 .. " + num(info.step_count - 1) + ")");
+        StepState& st = steps[k];
+        std::call_once(st.once, [&] {
+            if (verify == Verify::Full)
+                for (int d = 0; d < info.dmax; ++d) format::verify_section_checksum(path, base, section(k, d));
+            st.sizes = dispatch_scalar_type(info.type, [&](auto t) {
+                using T = decltype(t);
+                return format::validate_tree<T>(path, arrays<T>(k), k);
+            });
+        });
+        return st.sizes;
+    }
+};
+
+// 1. Map: the file is never read through anything but this read-only mapping.
+void OctFile::Impl::map_file() {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw Error(path, std::string("cannot open: ") + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) {
+        const int e = errno;
+        ::close(fd);
+        throw Error(path, std::string("cannot stat: ") + std::strerror(e));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        ::close(fd);
+        fail("not a regular file");
+    }
+    bytes = uint64_t(st.st_size);
+    if (bytes < sizeof(FileHeader)) {
+        ::close(fd);
+        fail("too short to be a .oct file (expected at least " + num(sizeof(FileHeader)) + " bytes, found " + num(bytes) + ")");
+    }
+    void* p = ::mmap(nullptr, size_t(bytes), PROT_READ, MAP_PRIVATE, fd, 0);
+    const int e = errno;
+    ::close(fd);   // the mapping keeps the file alive
+    if (p == MAP_FAILED) throw Error(path, std::string("cannot map: ") + std::strerror(e), ErrorKind::Other);
+    base = static_cast<const std::byte*>(p);
+}
+
+// 2. Header: identity first (magic, endianness, version, size), then its checksum, then fields.
+void OctFile::Impl::check_header() {
+    FileHeader h;
+    std::memcpy(&h, base, sizeof h);
+    if (std::memcmp(h.magic, format::kMagic, sizeof h.magic) != 0) fail("not a .oct file (bad magic bytes)");
+    if (h.endian_tag != format::kEndianTag)
+        fail("byte order tag mismatch (expected 0x01020304, found 0x" + [&] {
+            char b[9];
+            std::snprintf(b, sizeof b, "%08x", h.endian_tag);
+            return std::string(b);
+        }() + "): written on a big-endian machine or damaged");
+    if (h.version != format::kFormatVersion)
+        fail("unsupported format version (expected " + num(format::kFormatVersion) + ", found " + num(h.version) + ")");
+    if (h.header_bytes != sizeof(FileHeader))
+        fail("bad header size (expected " + num(sizeof(FileHeader)) + ", found " + num(h.header_bytes) + ")");
+    if (format::checksum(base, format::kHeaderChecksummedBytes) != h.header_checksum) fail("header checksum mismatch");
+    if (h.file_bytes != bytes)
+        fail(std::string(bytes < h.file_bytes ? "truncated" : "has trailing bytes") + " (expected " + num(h.file_bytes) +
+             " bytes, found " + num(bytes) + ")");
+    if (h.scalar_type >= kScalarTypeCount)
+        fail("unknown scalar type code (expected 0 .. " + num(kScalarTypeCount - 1) + ", found " + num(h.scalar_type) + ")");
+    info.type = ScalarType(h.scalar_type);
+    if (h.scalar_bytes != scalar_type_bytes(info.type))
+        fail("scalar size does not match type " + std::string(scalar_type_name(info.type)) + " (expected " +
+             num(scalar_type_bytes(info.type)) + ", found " + num(h.scalar_bytes) + ")");
+    for (int i = 0; i < 3; ++i)
+        if (h.dims[i] < 1 || h.dims[i] > Dims::kMaxExtent)
+            fail("grid extent " + std::string(1, "xyz"[i]) + " out of range (expected 1 .. " + num(Dims::kMaxExtent) +
+                 ", found " + num(h.dims[i]) + ")");
+    info.dims = Dims{h.dims[0], h.dims[1], h.dims[2]};
+    info.dmax = dmax_for(info.dims);
+    if (h.dmax != info.dmax)
+        fail("dmax does not match the grid " + num(h.dims[0]) + "x" + num(h.dims[1]) + "x" + num(h.dims[2]) +
+             " (expected " + num(info.dmax) + ", found " + num(h.dmax) + ")");
+    for (int i = 0; i < 3; ++i) {
+        if (!std::isfinite(h.spacing[i]) || !(h.spacing[i] > 0)) fail("spacing must be finite and positive");
+        if (!std::isfinite(h.origin[i])) fail("origin must be finite");
+        info.placement.spacing[size_t(i)] = h.spacing[i];
+        info.placement.origin[size_t(i)] = h.origin[i];
+    }
+    if (h.has_iso_range > 1) fail("bad iso-range flag (expected 0 or 1, found " + num(h.has_iso_range) + ")");
+    if (h.has_iso_range) {
+        if (!std::isfinite(h.iso_range[0]) || !std::isfinite(h.iso_range[1]) || !(h.iso_range[0] < h.iso_range[1]))
+            fail("iso-range must be finite with LO < HI");
+        info.iso_range = std::array<double, 2>{h.iso_range[0], h.iso_range[1]};
+    } else if (h.iso_range[0] != 0 || h.iso_range[1] != 0) {
+        fail("iso-range values present without the iso-range flag");
+    }
+    if (!std::isfinite(h.tolerance) || !(h.tolerance >= 0)) fail("tolerance must be finite and >= 0");
+    info.tolerance = h.tolerance;
+    if (h.step_count == 0) fail("holds no time steps");
+    info.step_count = h.step_count;
+    if (h.reserved0 != 0 || !all_zero(reinterpret_cast<const std::byte*>(h.reserved), sizeof h.reserved))
+        fail("reserved header bytes are not zero");
+}
+
+// 3. Section table: bounds without overflow, its checksum, then every entry.
+void OctFile::Impl::check_table() {
+    FileHeader h;
+    std::memcpy(&h, base, sizeof h);
+    if (h.section_entry_bytes != sizeof(SectionEntry))
+        fail("bad section entry size (expected " + num(sizeof(SectionEntry)) + ", found " + num(h.section_entry_bytes) + ")");
+    const uint64_t dmax = uint64_t(info.dmax);
+    const uint64_t expected_count = uint64_t(info.step_count) * dmax;   // < 2^32 * 31: no overflow
+    if (h.section_count != expected_count)
+        fail("section count does not match " + num(info.step_count) + " steps of dmax " + num(dmax) + " (expected " +
+             num(expected_count) + ", found " + num(h.section_count) + ")");
+    const uint64_t table_bytes = expected_count * sizeof(SectionEntry);
+    // A hostile header can make offset + bytes wrap around, so compare without adding.
+    if (table_bytes > bytes || h.section_table_offset > bytes - table_bytes)
+        fail("section table runs past end of file (" + num(table_bytes) + " bytes at offset " +
+             num(h.section_table_offset) + ", file " + num(bytes) + " bytes)");
+    if (h.section_table_offset % format::kSectionAlign != 0)
+        fail("section table offset not 64-byte aligned (found " + num(h.section_table_offset) + ")");
+    if (format::checksum(base + h.section_table_offset, size_t(table_bytes)) != h.section_table_checksum)
+        fail("section table checksum mismatch");
+    table = reinterpret_cast<const SectionEntry*>(base + h.section_table_offset);
+
+    const uint64_t interior_rec = format::interior_record_bytes(scalar_type_bytes(info.type));
+    const uint64_t cap_rec = format::cap_record_bytes(scalar_type_bytes(info.type));
+    uint64_t end = sizeof(FileHeader);   // end of the previous region (header, then sections)
+    for (uint64_t i = 0; i < expected_count; ++i) {
+        const SectionEntry& s = table[i];
+        const uint64_t step = i / dmax, depth = i % dmax;
+        const std::string name = "section " + num(i) + " (step " + num(step) + ", depth " + num(depth) + ")";
+        if (s.step != step || s.depth != depth)
+            fail(name + ": sections must be listed in (step, depth) order (expected step " + num(step) + ", depth " +
+                 num(depth) + ", found step " + num(s.step) + ", depth " + num(s.depth) + ")");
+        const bool is_caps = depth == dmax - 1;
+        const uint32_t kind = uint32_t(is_caps ? format::SectionKind::Caps : format::SectionKind::Interior);
+        if (s.kind != kind) fail(name + ": wrong section kind (expected " + num(kind) + ", found " + num(s.kind) + ")");
+        const uint64_t rec = is_caps ? cap_rec : interior_rec;
+        if (s.record_bytes != rec)
+            fail(name + ": record size does not match type " + std::string(scalar_type_name(info.type)) + " (expected " +
+                 num(rec) + ", found " + num(s.record_bytes) + ")");
+        if (s.bytes > bytes || s.offset > bytes - s.bytes)
+            fail(name + ": runs past end of file (" + num(s.bytes) + " bytes at offset " + num(s.offset) + ", file " +
+                 num(bytes) + " bytes)");
+        if (s.count > s.bytes / rec || s.count * rec != s.bytes)
+            fail(name + ": byte size does not match the record count (expected " + num(s.count) + " x " + num(rec) +
+                 " bytes, found " + num(s.bytes) + ")");
+        if (depth == 0 && s.count != 1)
+            fail(name + ": the root level must hold exactly one node (expected 1, found " + num(s.count) + ")");
+        // Canonical placement: right after the previous region, at the next multiple of 64,
+        // with zero padding in between (so no byte of the file escapes every check).
+        const uint64_t at = format::align_up(end);
+        if (s.offset != at)
+            fail(name + ": not at its canonical offset (expected " + num(at) + ", found " + num(s.offset) + ")");
+        if (!all_zero(base + end, at - end)) fail(name + ": padding before the section is not zero");
+        end = s.offset + s.bytes;   // <= bytes, checked above
+    }
+    const uint64_t at = format::align_up(end);
+    if (h.section_table_offset != at)
+        fail("section table not at its canonical offset (expected " + num(at) + ", found " + num(h.section_table_offset) + ")");
+    if (!all_zero(base + end, at - end)) fail("padding before the section table is not zero");
+    if (h.section_table_offset + table_bytes != bytes)
+        fail("bytes after the section table (expected the file to end at " + num(h.section_table_offset + table_bytes) +
+             ", found " + num(bytes) + " bytes)");
+}
+
+OctFile::OctFile() : impl_(std::make_unique<Impl>()) {}
+OctFile::OctFile(OctFile&&) noexcept = default;
+OctFile& OctFile::operator=(OctFile&&) noexcept = default;
+OctFile::~OctFile() = default;
+
+OctFile OctFile::open(const std::string& path, Verify verify) {
+    OctFile f;
+    Impl& m = *f.impl_;
+    m.path = path;
+    m.verify = verify;
+    m.map_file();
+    m.check_header();
+    m.check_table();
+    m.steps = std::make_unique<StepState[]>(m.info.step_count);
+    return f;
+}
+
+const OctInfo& OctFile::info() const { return impl_->info; }
+const std::string& OctFile::path() const { return impl_->path; }
+uint64_t OctFile::file_bytes() const { return impl_->bytes; }
+
+template <typename T> Octree<T> OctFile::step(uint32_t k) const {
+    if (scalar_type_of<T>() != impl_->info.type)
+        impl_->fail("holds " + std::string(scalar_type_name(impl_->info.type)) + " data, requested as " +
+                    std::string(scalar_type_name(scalar_type_of<T>())));
+    impl_->ensure_valid(k);
+    return Octree<T>(impl_->arrays<T>(k));
+}
+
+StepSizes OctFile::step_sizes(uint32_t k) const { return impl_->ensure_valid(k); }
+
+template Octree<uint8_t> OctFile::step<uint8_t>(uint32_t) const;
+template Octree<int8_t> OctFile::step<int8_t>(uint32_t) const;
+template Octree<uint16_t> OctFile::step<uint16_t>(uint32_t) const;
+template Octree<int16_t> OctFile::step<int16_t>(uint32_t) const;
+template Octree<uint32_t> OctFile::step<uint32_t>(uint32_t) const;
+template Octree<int32_t> OctFile::step<int32_t>(uint32_t) const;
+template Octree<float> OctFile::step<float>(uint32_t) const;
+template Octree<double> OctFile::step<double>(uint32_t) const;
+
+}  // namespace octiso

@@ -1,0 +1,140 @@
+// The on-disk layout of a .oct file: header, section table entries, alignment and the checksum
+// helper. Plain structs written and mapped byte for byte (little-endian hosts only), so a mapped
+// file hands out InteriorNode<T> / Cap<T> arrays without copying. writer.cpp produces exactly this
+// layout; loader.cpp and validate.cpp reject anything else.
+#pragma once
+
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+#include "octiso/octree.h"
+
+// ---------------------------------------------------------------------------------------------
+//  A .oct file (every multi-byte number little-endian, every section start 64-byte aligned)
+//
+//  offset 0    +-------------------------------------------------------------+
+//              | FileHeader (256 bytes)                                       |
+//              |   magic "OCTISO\0\x1a" | version | header_bytes | endian tag |
+//              |   scalar type, dims, dmax, spacing, origin, iso-range,        |
+//              |   tolerance, step count, table offset/count, file bytes,      |
+//              |   XXH3-64 of the table, XXH3-64 of header bytes [0, 248)      |
+//  256         +-------------------------------------------------------------+
+//              | zero padding to the next multiple of 64                      |
+//              +-------------------------------------------------------------+
+//              | step 0, depth 0:        InteriorNode<T>[1]       (the root)  |
+//              | step 0, depth 1:        InteriorNode<T>[n1]                  |
+//              |   ...                                                        |
+//              | step 0, depth dmax-2:   InteriorNode<T>[n(dmax-2)]           |
+//              | step 0, depth dmax-1:   Cap<T>[n_caps]                       |
+//              | step 1, depth 0 ...     (each section starts at the next     |
+//              |   ...                    multiple of 64; gaps are zero)      |
+//              | step S-1, depth dmax-1: Cap<T>[...]                          |
+//              +-------------------------------------------------------------+
+//              | SectionEntry[S * dmax]  (64-aligned, in (step, depth) order) |
+//  file_bytes  +-------------------------------------------------------------+
+//
+//  The layout is canonical: section i of the table sits at align64(end of section i-1) (the
+//  first at align64(256)), the table at align64(end of the last section), and the file ends
+//  with the table. So every byte of the file is covered by a checksum or must be zero, and a
+//  single flipped bit anywhere is detected (Verify::Full).
+//
+//  InteriorNode<T> record (24*sizeof(T) + 8 bytes, no padding):
+//    +-----------+---------+---------+-------------+------------+-------------+
+//    | scalar[8] | min[8]  | max[8]  | child_start | child_mask | reserved[3] |
+//    | 8 T       | 8 T     | 8 T     | u32         | u8         | zero        |
+//    +-----------+---------+---------+-------------+------------+-------------+
+//  Cap<T> record: voxel[8], 8*sizeof(T) bytes. Octant c = x<<2 | y<<1 | z.
+// ---------------------------------------------------------------------------------------------
+
+namespace octiso::format {
+
+static_assert(std::endian::native == std::endian::little,
+              ".oct files are mapped without byte swapping: little-endian hosts only");
+
+inline constexpr char kMagic[8] = {'O', 'C', 'T', 'I', 'S', 'O', '\0', '\x1a'};
+inline constexpr uint32_t kFormatVersion = 1;
+inline constexpr uint32_t kEndianTag = 0x01020304u;   ///< reads back as 0x04030201 if swapped
+inline constexpr uint64_t kSectionAlign = 64;
+
+enum class SectionKind : uint32_t { Interior = 1, Caps = 2 };
+
+/// The 256-byte header at offset 0. Field offsets are fixed by the static_asserts below.
+struct FileHeader {
+    char magic[8];                    //   0  kMagic
+    uint32_t version;                 //   8  kFormatVersion
+    uint32_t header_bytes;            //  12  sizeof(FileHeader)
+    uint32_t endian_tag;              //  16  kEndianTag
+    uint8_t scalar_type;              //  20  ScalarType numeric value
+    uint8_t scalar_bytes;             //  21  sizeof(T)
+    uint8_t has_iso_range;            //  22  0 or 1
+    uint8_t dmax;                     //  23  dmax_for(dims)
+    uint32_t dims[3];                 //  24  NX, NY, NZ in [1, Dims::kMaxExtent]
+    uint32_t step_count;              //  36  >= 1
+    double spacing[3];                //  40  finite, > 0
+    double origin[3];                 //  64  finite
+    double iso_range[2];              //  88  lo < hi if has_iso_range, else zero
+    double tolerance;                 // 104  finite, >= 0 (0: lossless)
+    uint64_t section_table_offset;    // 112  multiple of 64
+    uint64_t section_count;           // 120  step_count * dmax
+    uint32_t section_entry_bytes;     // 128  sizeof(SectionEntry)
+    uint32_t reserved0;               // 132  zero
+    uint64_t file_bytes;              // 136  length of the whole file
+    uint64_t section_table_checksum;  // 144  XXH3-64 of the table bytes
+    uint8_t reserved[96];             // 152  zero
+    uint64_t header_checksum;         // 248  XXH3-64 of header bytes [0, 248)
+};
+
+/// One entry of the section table: where the records of (step, depth) live.
+struct SectionEntry {
+    uint32_t kind;           //  0  SectionKind: Interior for depth <= dmax-2, Caps at dmax-1
+    uint32_t step;           //  4  0 .. step_count-1
+    uint32_t depth;          //  8  0 .. dmax-1
+    uint32_t record_bytes;   // 12  sizeof(InteriorNode<T>) or sizeof(Cap<T>)
+    uint64_t offset;         // 16  multiple of 64
+    uint64_t bytes;          // 24  count * record_bytes
+    uint64_t count;          // 32  records
+    uint64_t checksum;       // 40  XXH3-64 of the section bytes
+};
+
+static_assert(std::is_trivially_copyable_v<FileHeader> && std::is_standard_layout_v<FileHeader>);
+static_assert(sizeof(FileHeader) == 256);
+static_assert(offsetof(FileHeader, version) == 8 && offsetof(FileHeader, endian_tag) == 16);
+static_assert(offsetof(FileHeader, scalar_type) == 20 && offsetof(FileHeader, dims) == 24);
+static_assert(offsetof(FileHeader, step_count) == 36 && offsetof(FileHeader, spacing) == 40);
+static_assert(offsetof(FileHeader, origin) == 64 && offsetof(FileHeader, iso_range) == 88);
+static_assert(offsetof(FileHeader, tolerance) == 104 && offsetof(FileHeader, section_table_offset) == 112);
+static_assert(offsetof(FileHeader, section_entry_bytes) == 128 && offsetof(FileHeader, file_bytes) == 136);
+static_assert(offsetof(FileHeader, section_table_checksum) == 144 && offsetof(FileHeader, reserved) == 152);
+static_assert(offsetof(FileHeader, header_checksum) == 248);
+inline constexpr size_t kHeaderChecksummedBytes = offsetof(FileHeader, header_checksum);
+
+static_assert(std::is_trivially_copyable_v<SectionEntry> && sizeof(SectionEntry) == 48);
+static_assert(offsetof(SectionEntry, offset) == 16 && offsetof(SectionEntry, checksum) == 40);
+
+/// The node records are written as raw bytes: their size must be exactly the drawing above.
+template <typename T> constexpr bool record_layout_ok() {
+    using N = InteriorNode<T>;
+    return std::is_trivially_copyable_v<N> && std::is_standard_layout_v<N> &&
+           sizeof(N) == 24 * sizeof(T) + 8 && offsetof(N, min) == 8 * sizeof(T) &&
+           offsetof(N, max) == 16 * sizeof(T) && offsetof(N, child_start) == 24 * sizeof(T) &&
+           offsetof(N, child_mask) == 24 * sizeof(T) + 4 && offsetof(N, reserved) == 24 * sizeof(T) + 5 &&
+           std::is_trivially_copyable_v<Cap<T>> && sizeof(Cap<T>) == 8 * sizeof(T) &&
+           alignof(N) <= kSectionAlign && alignof(Cap<T>) <= kSectionAlign;
+}
+static_assert(record_layout_ok<uint8_t>() && record_layout_ok<int8_t>() && record_layout_ok<uint16_t>() &&
+              record_layout_ok<int16_t>() && record_layout_ok<uint32_t>() && record_layout_ok<int32_t>() &&
+              record_layout_ok<float>() && record_layout_ok<double>());
+
+/// Size of one record of each kind for a scalar of `scalar_bytes` bytes (1, 2, 4 or 8).
+inline constexpr uint64_t interior_record_bytes(uint64_t scalar_bytes) { return 24 * scalar_bytes + 8; }
+inline constexpr uint64_t cap_record_bytes(uint64_t scalar_bytes) { return 8 * scalar_bytes; }
+
+/// Next multiple of 64 at or above `x`; callers keep x far below 2^64 (checked before use).
+inline constexpr uint64_t align_up(uint64_t x) { return (x + kSectionAlign - 1) & ~(kSectionAlign - 1); }
+
+/// XXH3-64 (seed 0) of a byte range; defined in validate.cpp so only one file includes xxhash.h.
+uint64_t checksum(const void* data, size_t bytes);
+
+}  // namespace octiso::format

@@ -1,0 +1,180 @@
+// Per-step validation of .oct octrees (see validate.h): section checksums, then the child indices
+// of every interior node, in parallel over chunks of nodes with a serial stitch of the chunk
+// boundaries. The only file that includes xxhash.h.
+#include "format/validate.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstdio>
+#include <optional>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+#include <xxhash.h>
+
+#include "octiso/error.h"
+
+namespace octiso::format {
+
+uint64_t checksum(const void* data, size_t bytes) { return XXH3_64bits(data, bytes); }
+
+namespace {
+
+std::string hex(uint64_t v) {
+    char buf[19];
+    std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(v));
+    return buf;
+}
+
+std::string where(uint32_t step, int depth, int dmax) {
+    return "step " + std::to_string(step) + ", depth " + std::to_string(depth) +
+           (depth == dmax - 1 ? " (caps)" : " (interior nodes)");
+}
+
+/// What one chunk of nodes at a depth found on its own; the stitch checks the boundaries.
+struct ChunkResult {
+    std::optional<uint64_t> first_parent;   ///< first node in the chunk with children
+    uint64_t first_start = 0;               ///< its child_start
+    uint64_t children = 0;                  ///< sum of popcount(child_mask) over the chunk
+    uint64_t leaves = 0;                    ///< sum of 8 - popcount
+    std::optional<uint64_t> bad_node;       ///< first node failing a local check
+    std::string problem;
+};
+
+constexpr uint64_t kChunk = 1u << 15;
+
+template <typename T>
+ChunkResult check_chunk(const InteriorNode<T>* nodes, uint64_t begin, uint64_t end, uint64_t next_count,
+                        const char* next_name) {
+    ChunkResult r;
+    uint64_t expected_start = 0;   // where the next node with children must start (after the first)
+    for (uint64_t i = begin; i < end; ++i) {
+        const InteriorNode<T>& n = nodes[i];
+        const uint64_t pc = uint64_t(std::popcount(unsigned(n.child_mask)));
+        const uint64_t start = n.child_start;
+        auto fail = [&](std::string problem) {
+            r.bad_node = i;
+            r.problem = std::move(problem);
+        };
+        if (n.reserved[0] | n.reserved[1] | n.reserved[2]) {
+            fail("reserved bytes are not zero");
+            return r;
+        }
+        if (start + pc > next_count) {
+            fail("child_start + popcount(child_mask) runs past the " + std::to_string(next_count) + " " + next_name +
+                 " below (expected <= " + std::to_string(next_count) + ", found " + std::to_string(start) + " + " +
+                 std::to_string(pc) + " = " + std::to_string(start + pc) + ")");
+            return r;
+        }
+        if (pc != 0) {
+            if (!r.first_parent) {
+                r.first_parent = i;
+                r.first_start = start;
+            } else if (start != expected_start) {
+                fail(std::string(start < expected_start ? "children overlap those of an earlier node"
+                                                        : "children leave a gap after those of an earlier node") +
+                     " (expected child_start " + std::to_string(expected_start) + ", found " + std::to_string(start) +
+                     ")");
+                return r;
+            }
+            expected_start = start + pc;
+        }
+        r.children += pc;
+        r.leaves += 8 - pc;
+    }
+    return r;
+}
+
+}  // namespace
+
+void verify_section_checksum(const std::string& subject, const std::byte* base, const SectionEntry& s) {
+    const uint64_t found = checksum(base + s.offset, size_t(s.bytes));
+    if (found != s.checksum)
+        throw Error(subject, "checksum mismatch in step " + std::to_string(s.step) + ", depth " +
+                                 std::to_string(s.depth) + " (" + std::to_string(s.bytes) + " bytes at offset " +
+                                 std::to_string(s.offset) + "; expected XXH3 " + hex(s.checksum) + ", found " +
+                                 hex(found) + ")");
+}
+
+template <typename T> StepSizes validate_tree(const std::string& subject, const OctreeArrays<T>& a, uint32_t step) {
+    const int dmax = a.dmax;
+    if (dmax < 2 || dmax >= kMaxDepth)
+        throw Error(subject, "step " + std::to_string(step) + ": dmax out of range (expected 2 .. " +
+                                 std::to_string(kMaxDepth - 1) + ", found " + std::to_string(dmax) + ")");
+    // 1. Counts: one root, and every depth addressable with 32-bit indices.
+    if (a.node_count[0] != 1)
+        throw Error(subject, where(step, 0, dmax) + ": the root level must hold exactly one node (expected 1, found " +
+                                 std::to_string(a.node_count[0]) + ")");
+    // Node indices are 32-bit (child_start, child_index()), so no depth may hold more than 2^32.
+    constexpr uint64_t kMaxPerDepth = uint64_t(1) << 32;
+    for (int d = 1; d < dmax; ++d) {
+        const uint64_t n = d == dmax - 1 ? a.cap_count : a.node_count[size_t(d)];
+        if (n > kMaxPerDepth)
+            throw Error(subject, where(step, d, dmax) + ": too many records for 32-bit child indices (expected <= " +
+                                     std::to_string(kMaxPerDepth) + ", found " + std::to_string(n) + ")");
+    }
+    StepSizes sizes;
+    sizes.nodes_per_depth.assign(size_t(dmax), 0);
+    sizes.scalar_leaves_per_depth.assign(size_t(dmax), 0);
+
+    for (int d = 0; d <= dmax - 2; ++d) {
+        const uint64_t count = a.node_count[size_t(d)];
+        const bool next_is_caps = d + 1 == dmax - 1;
+        const uint64_t next_count = next_is_caps ? a.cap_count : a.node_count[size_t(d + 1)];
+        const InteriorNode<T>* nodes = a.nodes[size_t(d)];
+        if (count != 0 && nodes == nullptr)
+            throw Error(subject, where(step, d, dmax) + ": " + std::to_string(count) + " nodes but no data");
+
+        // 2. Local checks per chunk in parallel, each chunk stopping at its first bad node.
+        const uint64_t n_chunks = (count + kChunk - 1) / kChunk;
+        std::vector<ChunkResult> chunks(n_chunks);
+        const char* next_name = next_is_caps ? "caps" : "nodes";
+        tbb::parallel_for(uint64_t(0), n_chunks, [&](uint64_t c) {
+            const uint64_t begin = c * kChunk;
+            const uint64_t end = std::min(count, begin + kChunk);
+            chunks[c] = check_chunk(nodes, begin, end, next_count, next_name);
+        });
+
+        // 3. Stitch: each chunk's first children start where the previous chunks' children end;
+        // the earliest failing node (local or boundary) is the one reported.
+        uint64_t covered = 0, leaves = 0;
+        for (const ChunkResult& r : chunks) {
+            if (r.first_parent && r.first_start != covered && (!r.bad_node || *r.first_parent < *r.bad_node))
+                throw Error(subject, where(step, d, dmax) + ", node " + std::to_string(*r.first_parent) + ": " +
+                                         (r.first_start < covered ? "children overlap those of an earlier node"
+                                                                  : "children leave a gap after those of an earlier node") +
+                                         " (expected child_start " + std::to_string(covered) + ", found " +
+                                         std::to_string(r.first_start) + ")");
+            if (r.bad_node) throw Error(subject, where(step, d, dmax) + ", node " + std::to_string(*r.bad_node) + ": " + r.problem);
+            covered += r.children;
+            leaves += r.leaves;
+        }
+        if (covered != next_count)
+            throw Error(subject, where(step, d + 1, dmax) + ": the parents' child masks do not cover the level exactly (expected " +
+                                     std::to_string(covered) + " " + next_name + ", found " + std::to_string(next_count) +
+                                     ")");
+        sizes.nodes_per_depth[size_t(d)] = count;
+        sizes.scalar_leaves_per_depth[size_t(d)] = leaves;
+        sizes.interior_bytes += count * sizeof(InteriorNode<T>);
+        sizes.minmax_bytes += count * 16 * sizeof(T);
+    }
+    if (a.cap_count != 0 && a.caps == nullptr)
+        throw Error(subject, where(step, dmax - 1, dmax) + ": " + std::to_string(a.cap_count) + " caps but no data");
+    sizes.nodes_per_depth[size_t(dmax - 1)] = a.cap_count;
+    sizes.cap_bytes = a.cap_count * sizeof(Cap<T>);
+    return sizes;
+}
+
+#define OCTISO_INSTANTIATE(T) \
+    template StepSizes validate_tree<T>(const std::string&, const OctreeArrays<T>&, uint32_t);
+OCTISO_INSTANTIATE(uint8_t)
+OCTISO_INSTANTIATE(int8_t)
+OCTISO_INSTANTIATE(uint16_t)
+OCTISO_INSTANTIATE(int16_t)
+OCTISO_INSTANTIATE(uint32_t)
+OCTISO_INSTANTIATE(int32_t)
+OCTISO_INSTANTIATE(float)
+OCTISO_INSTANTIATE(double)
+#undef OCTISO_INSTANTIATE
+
+}  // namespace octiso::format

@@ -1,0 +1,186 @@
+// OctWriter: streams a .oct file step by step into an AtomicOutput temporary (nothing but the
+// current step's arrays is ever held), then appends the section table, rewrites the header at
+// offset 0, syncs and renames. The layout it produces is drawn in oct_layout.h.
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include <unistd.h>
+
+#include "format/oct_layout.h"
+#include "format/validate.h"
+#include "io/atomic_output.h"
+#include "octiso/error.h"
+#include "octiso/oct_file.h"
+
+namespace octiso {
+
+using format::FileHeader;
+using format::SectionEntry;
+
+struct OctWriter::Impl {
+    OctInfo info;
+    AtomicOutput out;
+    std::FILE* file = nullptr;
+    uint64_t pos = 0;                  // bytes written so far (the file position)
+    std::vector<SectionEntry> table;
+    bool broken = false;               // a write failed: finish() must not publish the file
+    bool finished = false;
+
+    Impl(std::string path, const OctInfo& i) : info(i), out(std::move(path)) {}
+    ~Impl() {
+        if (file) std::fclose(file);   // before AtomicOutput's destructor removes the temporary
+    }
+
+    [[noreturn]] void fail_io(const std::string& what) {
+        broken = true;
+        throw Error(out.path(), what + ": " + std::strerror(errno), ErrorKind::Other);
+    }
+    void write(const void* data, uint64_t n) {
+        if (n != 0 && std::fwrite(data, 1, size_t(n), file) != size_t(n)) fail_io("write failed");
+        pos += n;
+    }
+    void pad_to_alignment() {
+        static constexpr std::byte kZeros[format::kSectionAlign] = {};
+        write(kZeros, format::align_up(pos) - pos);
+    }
+    void add_section(format::SectionKind kind, uint32_t step, int depth, uint32_t record_bytes, const void* data,
+                     uint64_t count) {
+        pad_to_alignment();
+        SectionEntry s{};
+        s.kind = uint32_t(kind);
+        s.step = step;
+        s.depth = uint32_t(depth);
+        s.record_bytes = record_bytes;
+        s.offset = pos;
+        s.count = count;
+        s.bytes = count * record_bytes;   // the arrays exist in memory, so this cannot overflow
+        s.checksum = format::checksum(data, size_t(s.bytes));
+        write(data, s.bytes);
+        table.push_back(s);
+    }
+};
+
+OctWriter::OctWriter(std::string path, const OctInfo& info) : impl_(std::make_unique<Impl>(std::move(path), info)) {
+    Impl& m = *impl_;
+    const std::string& p = m.out.path();
+    // The header must pass the loader's checks later, so refuse what it would refuse now.
+    for (uint32_t e : {info.dims.x, info.dims.y, info.dims.z})
+        if (e < 1 || e > Dims::kMaxExtent)
+            throw Error(p, "grid extent out of range (expected 1 .. " + std::to_string(Dims::kMaxExtent) + ", found " +
+                               std::to_string(e) + ")");
+    if (info.dmax != 0 && info.dmax != dmax_for(info.dims))
+        throw Error(p, "dmax does not match the grid (expected " + std::to_string(dmax_for(info.dims)) + ", found " +
+                           std::to_string(info.dmax) + ")");
+    m.info.dmax = dmax_for(info.dims);
+    m.info.step_count = 0;
+    for (int i = 0; i < 3; ++i) {
+        if (!std::isfinite(info.placement.spacing[size_t(i)]) || !(info.placement.spacing[size_t(i)] > 0))
+            throw Error(p, "spacing must be finite and positive");
+        if (!std::isfinite(info.placement.origin[size_t(i)])) throw Error(p, "origin must be finite");
+    }
+    if (info.iso_range && !((*info.iso_range)[0] < (*info.iso_range)[1] && std::isfinite((*info.iso_range)[0]) &&
+                            std::isfinite((*info.iso_range)[1])))
+        throw Error(p, "iso-range must be finite with LO < HI");
+    if (!std::isfinite(info.tolerance) || !(info.tolerance >= 0)) throw Error(p, "tolerance must be finite and >= 0");
+
+    m.file = std::fopen(m.out.temp_path().c_str(), "wb");
+    if (!m.file) throw Error(m.out.temp_path(), std::string("cannot create: ") + std::strerror(errno), ErrorKind::Other);
+    // Placeholder header; the real one is written at finish(), when the table is known.
+    const FileHeader zero{};
+    m.write(&zero, sizeof zero);
+}
+
+OctWriter::~OctWriter() = default;
+
+template <typename T> void OctWriter::add_step(const Octree<T>& octree) {
+    Impl& m = *impl_;
+    const std::string& p = m.out.path();
+    if (m.finished) throw Error(p, "add_step() after finish()", ErrorKind::Other);
+    if (m.broken) throw Error(p, "an earlier write failed", ErrorKind::Other);
+    if (scalar_type_of<T>() != m.info.type)
+        throw Error(p, "step of type " + std::string(scalar_type_name(scalar_type_of<T>())) + " added to a file of type " +
+                           std::string(scalar_type_name(m.info.type)), ErrorKind::Other);
+    if (octree.dims() != m.info.dims || octree.dmax() != m.info.dmax)
+        throw Error(p, "step grid does not match the file (expected dmax " + std::to_string(m.info.dmax) + ", found " +
+                           std::to_string(octree.dmax()) + ", or other extents)", ErrorKind::Other);
+    const uint32_t step = m.info.step_count;
+    if (step == UINT32_MAX) throw Error(p, "too many time steps", ErrorKind::Other);
+    // The loader would reject a file with a bad tree; refuse to write one in the first place.
+    try {
+        format::validate_tree<T>(p, octree.arrays(), step);
+    } catch (const Error& e) {
+        throw Error(p, "refusing to write an inconsistent octree: " + e.problem(), ErrorKind::Other);
+    }
+    const OctreeArrays<T>& a = octree.arrays();
+    for (int d = 0; d + 1 < a.dmax; ++d)
+        m.add_section(format::SectionKind::Interior, step, d, uint32_t(sizeof(InteriorNode<T>)), a.nodes[size_t(d)],
+                      a.node_count[size_t(d)]);
+    m.add_section(format::SectionKind::Caps, step, a.dmax - 1, uint32_t(sizeof(Cap<T>)), a.caps, a.cap_count);
+    m.info.step_count = step + 1;
+}
+
+void OctWriter::finish() {
+    Impl& m = *impl_;
+    const std::string& p = m.out.path();
+    if (m.finished) throw Error(p, "finish() called twice", ErrorKind::Other);
+    if (m.broken) throw Error(p, "an earlier write failed", ErrorKind::Other);
+    if (m.info.step_count == 0) throw Error(p, "no time steps were added", ErrorKind::Other);
+
+    m.pad_to_alignment();
+    FileHeader h{};
+    std::memcpy(h.magic, format::kMagic, sizeof h.magic);
+    h.version = format::kFormatVersion;
+    h.header_bytes = sizeof(FileHeader);
+    h.endian_tag = format::kEndianTag;
+    h.scalar_type = uint8_t(m.info.type);
+    h.scalar_bytes = uint8_t(scalar_type_bytes(m.info.type));
+    h.has_iso_range = m.info.iso_range ? 1 : 0;
+    h.dmax = uint8_t(m.info.dmax);
+    h.dims[0] = m.info.dims.x;
+    h.dims[1] = m.info.dims.y;
+    h.dims[2] = m.info.dims.z;
+    h.step_count = m.info.step_count;
+    for (int i = 0; i < 3; ++i) {
+        h.spacing[i] = m.info.placement.spacing[size_t(i)];
+        h.origin[i] = m.info.placement.origin[size_t(i)];
+    }
+    if (m.info.iso_range) {
+        h.iso_range[0] = (*m.info.iso_range)[0];
+        h.iso_range[1] = (*m.info.iso_range)[1];
+    }
+    h.tolerance = m.info.tolerance;
+    h.section_table_offset = m.pos;
+    h.section_count = m.table.size();
+    h.section_entry_bytes = sizeof(SectionEntry);
+    const uint64_t table_bytes = m.table.size() * sizeof(SectionEntry);
+    h.section_table_checksum = format::checksum(m.table.data(), size_t(table_bytes));
+    m.write(m.table.data(), table_bytes);
+    h.file_bytes = m.pos;
+    h.header_checksum = format::checksum(&h, format::kHeaderChecksummedBytes);
+
+    if (std::fseek(m.file, 0, SEEK_SET) != 0) m.fail_io("seek failed");
+    if (std::fwrite(&h, 1, sizeof h, m.file) != sizeof h) m.fail_io("write failed");
+    if (std::fflush(m.file) != 0) m.fail_io("write failed");
+    if (::fsync(::fileno(m.file)) != 0) m.fail_io("sync failed");
+    const int rc = std::fclose(m.file);
+    m.file = nullptr;
+    if (rc != 0) m.fail_io("close failed");
+    m.out.commit();
+    m.finished = true;
+}
+
+uint64_t OctWriter::bytes_written() const { return impl_->pos; }
+
+template void OctWriter::add_step<uint8_t>(const Octree<uint8_t>&);
+template void OctWriter::add_step<int8_t>(const Octree<int8_t>&);
+template void OctWriter::add_step<uint16_t>(const Octree<uint16_t>&);
+template void OctWriter::add_step<int16_t>(const Octree<int16_t>&);
+template void OctWriter::add_step<uint32_t>(const Octree<uint32_t>&);
+template void OctWriter::add_step<int32_t>(const Octree<int32_t>&);
+template void OctWriter::add_step<float>(const Octree<float>&);
+template void OctWriter::add_step<double>(const Octree<double>&);
+
+}  // namespace octiso

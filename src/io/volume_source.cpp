@@ -1,0 +1,159 @@
+// LoadedVolume's constructor, format names and detection (extension first, then magic bytes), and
+// open_volume(): the one entry point the converter uses to turn a path and the raw/placement
+// flags of CONVENTIONS 3 into a checked LoadedVolume. The readers themselves live in
+// raw_reader.cpp and vtk_reader.cpp.
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "io/input_file.h"
+#include "octiso/reader.h"
+
+namespace octiso {
+
+LoadedVolume::LoadedVolume(std::shared_ptr<const void> owner, const std::byte* data, ScalarType type, Dims dims,
+                           Placement placement, bool swap_bytes, std::string source, VolumeFormat format)
+    : owner_(std::move(owner)), data_(data), type_(type), dims_(dims), placement_(placement),
+      swap_bytes_(swap_bytes), source_(std::move(source)), format_(format) {}
+
+std::string_view volume_format_name(VolumeFormat f) {
+    switch (f) {
+        case VolumeFormat::raw: return "raw";
+        case VolumeFormat::nifti: return "NIfTI";
+        case VolumeFormat::vti: return "VTK XML image data";
+        case VolumeFormat::legacy_vtk: return "legacy VTK";
+        case VolumeFormat::meta_image: return "MetaImage";
+        case VolumeFormat::nrrd: return "NRRD";
+        case VolumeFormat::synthetic: return "synthetic";
+    }
+    return "unknown";
+}
+
+namespace io {
+
+uint64_t check_input_file(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) {
+        if (errno == ENOENT || errno == ENOTDIR) throw Error(path, "no such file");
+        throw Error(path, std::string("cannot access: ") + std::strerror(errno));
+    }
+    if (S_ISDIR(st.st_mode)) throw Error(path, "is a directory, not a volume file");
+    if (!S_ISREG(st.st_mode)) throw Error(path, "is not a regular file");
+    if (::access(path.c_str(), R_OK) != 0) throw Error(path, std::string("not readable: ") + std::strerror(errno));
+    return uint64_t(st.st_size);
+}
+
+}  // namespace io
+
+namespace {
+
+std::string lower(std::string s) {
+    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return s;
+}
+
+bool ends_with(const std::string& s, std::string_view suffix) {
+    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::optional<VolumeFormat> format_from_extension(const std::string& path) {
+    const std::string p = lower(path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1));
+    if (ends_with(p, ".nii") || ends_with(p, ".nii.gz")) return VolumeFormat::nifti;
+    if (ends_with(p, ".vti")) return VolumeFormat::vti;
+    if (ends_with(p, ".vtk")) return VolumeFormat::legacy_vtk;
+    if (ends_with(p, ".mhd") || ends_with(p, ".mha")) return VolumeFormat::meta_image;
+    if (ends_with(p, ".nrrd") || ends_with(p, ".nhdr")) return VolumeFormat::nrrd;
+    return std::nullopt;
+}
+
+// Magic bytes. NIfTI is recognised only to say that it needs its extension: VTK's reader derives
+// header and image names from it.
+std::optional<VolumeFormat> format_from_magic(const std::string& path) {
+    char head[512] = {};
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return std::nullopt;
+    const ssize_t n = ::read(fd, head, sizeof head - 1);
+    ::close(fd);
+    if (n <= 0) return std::nullopt;
+    const std::string_view text(head, size_t(n));
+    if (text.starts_with("NRRD000")) return VolumeFormat::nrrd;
+    if (text.starts_with("# vtk DataFile")) return VolumeFormat::legacy_vtk;
+    if ((text.starts_with("<?xml") || text.starts_with("<VTKFile")) && text.find("<VTKFile") != text.npos &&
+        text.find("\"ImageData\"") != text.npos)
+        return VolumeFormat::vti;
+    if (text.starts_with("ObjectType = Image")) return VolumeFormat::meta_image;
+    // NIfTI-1: sizeof_hdr 348 at byte 0, magic "n+1" at 344; NIfTI-2: 540 and "n+2" at 4.
+    if (n >= 348 && text.substr(344, 4) == std::string_view("n+1\0", 4)) return VolumeFormat::nifti;
+    if (n >= 8 && text.substr(4, 4) == std::string_view("n+2\0", 4)) return VolumeFormat::nifti;
+    return std::nullopt;
+}
+
+void check_placement(const Placement& p, const std::string& path) {
+    for (int a = 0; a < 3; ++a) {
+        if (!std::isfinite(p.spacing[size_t(a)]) || !(p.spacing[size_t(a)] > 0))
+            throw Error(path, "spacing must be finite and positive (found " + std::to_string(p.spacing[0]) + "," +
+                                  std::to_string(p.spacing[1]) + "," + std::to_string(p.spacing[2]) +
+                                  "); override it with --spacing");
+        if (!std::isfinite(p.origin[size_t(a)])) throw Error(path, "origin is not finite; override it with --origin");
+    }
+}
+
+}  // namespace
+
+VolumeFormat detect_volume_format(const std::string& path) {
+    if (auto f = format_from_extension(path)) return *f;
+    if (auto f = format_from_magic(path)) return *f;
+    return VolumeFormat::raw;
+}
+
+LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
+    io::check_input_file(path);
+    const bool raw_flags = options.dims || options.type;
+
+    // 1. An extension names the format outright; raw-only flags then mean a confused command line.
+    // 2. Magic bytes claim an extension-less file, unless --dims/--type say it is raw.
+    // 3. Anything else is raw (CONVENTIONS 3).
+    VolumeFormat format = VolumeFormat::raw;
+    if (auto f = format_from_extension(path)) {
+        format = *f;
+        const char* flag = options.dims ? "--dims" : options.type ? "--type" : options.endian ? "--endian"
+                         : options.offset ? "--offset" : nullptr;
+        if (flag)
+            throw Error(flag, "applies only to raw input, and '" + path + "' is read as " +
+                                  std::string(volume_format_name(format)));
+    } else if (!raw_flags) {
+        if (auto m = format_from_magic(path)) format = *m;
+        if (format == VolumeFormat::nifti)
+            throw Error(path, "looks like NIfTI, but VTK's NIfTI reader needs a .nii or .nii.gz name "
+                              "(or give --dims and --type to read it as raw)");
+    }
+
+    LoadedVolume volume;
+    if (format == VolumeFormat::raw) {
+        if (!options.dims)
+            throw Error("--dims", "raw input '" + path + "' needs --dims NX,NY,NZ (no other format claims the file)");
+        if (!options.type)
+            throw Error("--type", "raw input '" + path + "' needs --type u8|i8|u16|i16|u32|i32|f32|f64");
+        volume = read_raw(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
+                          options.offset.value_or(0));
+    } else {
+        if (options.endian || options.offset)
+            throw Error(options.endian ? "--endian" : "--offset",
+                        "applies only to raw input, and '" + path + "' is read as " +
+                            std::string(volume_format_name(format)));
+        volume = read_vtk(path, format);
+    }
+
+    Placement placement = volume.placement();
+    if (options.spacing) placement.spacing = *options.spacing;
+    if (options.origin) placement.origin = *options.origin;
+    check_placement(placement, path);
+    volume.set_placement(placement);
+    return volume;
+}
+
+}  // namespace octiso

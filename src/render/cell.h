@@ -1,0 +1,97 @@
+// The math of one trilinear cell (Knoll et al. 2006, Sec. 4.4; notes/rootfinding.md 1.1): the
+// interpolant, its gradient, and the cubic f(p_in + s*(p_out - p_in)) - iso on the segment s in
+// [0,1], scale-normalised by a power of two. Header-only, no allocation; the root finders that
+// consume the cubic live in roots.h, the world-space normal there too.
+//
+// Corner order: corner[i + 2*j + 4*k], i,j,k in {0,1} along x,y,z (x fastest, like the volume).
+#pragma once
+
+#include <array>
+#include <cmath>
+
+namespace octiso {
+
+/// a at t = 0, b at t = 1, written so that both ends are exact (a*1 + b*0 == a): two cells that
+/// share a face then compute bitwise the same value on it, which the half-open rule relies on.
+template <typename R> inline R cell_lerp(R a, R b, R t) { return a * (R(1) - t) + b * t; }
+
+/// Trilinear interpolant of the 8 corners at p_cell (cell-local, [0,1]^3; extrapolates outside).
+template <typename R> inline R trilinear(const R c[8], R x, R y, R z) {
+    const R y0 = cell_lerp(cell_lerp(c[0], c[1], x), cell_lerp(c[2], c[3], x), y);
+    const R y1 = cell_lerp(cell_lerp(c[4], c[5], x), cell_lerp(c[6], c[7], x), y);
+    return cell_lerp(y0, y1, z);
+}
+inline double trilinear(const double c[8], const std::array<double, 3>& p_cell) {
+    return trilinear<double>(c, p_cell[0], p_cell[1], p_cell[2]);
+}
+
+/// Gradient of the trilinear interpolant at p_cell, in value per cell-local unit (per index step).
+inline std::array<double, 3> gradient(const double c[8], const std::array<double, 3>& p_cell) {
+    const double x = p_cell[0], y = p_cell[1], z = p_cell[2];
+    const double dx = cell_lerp(cell_lerp(c[1] - c[0], c[3] - c[2], y), cell_lerp(c[5] - c[4], c[7] - c[6], y), z);
+    const double dy = cell_lerp(cell_lerp(c[2] - c[0], c[3] - c[1], x), cell_lerp(c[6] - c[4], c[7] - c[5], x), z);
+    const double dz = cell_lerp(cell_lerp(c[4] - c[0], c[5] - c[1], x), cell_lerp(c[6] - c[2], c[7] - c[3], x), y);
+    return {dx, dy, dz};
+}
+
+/// f(s) = c[0] + c[1] s + c[2] s^2 + c[3] s^3 = (trilinear(p_in + s (p_out - p_in)) - iso) * 2^-scale_exp.
+/// Invariants: f_in == c[0] (direct trilinear at p_in) and f_out is the direct trilinear value at
+/// p_out under the same scaling, so the endpoint signs agree with the neighbouring cells (their
+/// shared face values are bitwise equal) even where Horner at s = 1 would round the other way.
+/// max(|c[i]|, |f_out|) is in [1/2, 1) unless everything is 0 (f identically iso on the segment).
+template <typename R> struct CellCubic {
+    R c[4];
+    R f_in, f_out;
+    int scale_exp;
+
+    R operator()(R s) const { return ((c[3] * s + c[2]) * s + c[1]) * s + c[0]; }
+    R derivative(R s) const { return (R(3) * c[3] * s + R(2) * c[2]) * s + c[1]; }
+    bool is_identically_zero() const { return c[0] == 0 && c[1] == 0 && c[2] == 0 && c[3] == 0 && f_out == 0; }
+};
+
+/// The cubic of the segment p_in -> p_out (cell-local) for the corners `corner` and `iso`, in
+/// arithmetic R (double for the fast finders, long double for the reference). Preconditions: all
+/// inputs finite. Never overflows: corners and iso are first scaled by 2^-e with 2^e > max(|corner|,
+/// |iso|) (exact: a power of two), so c - iso == 0 exactly where corner == iso, whatever the scale.
+template <typename R>
+inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const std::array<double, 3>& p_in,
+                                    const std::array<double, 3>& p_out) {
+    // 1. g = (corner - iso) * 2^-e, in [-2, 2].
+    double m = std::fabs(iso);
+    for (int i = 0; i < 8; ++i) m = std::fmax(m, std::fabs(corner[i]));
+    int e = 0;
+    if (m > 0) std::frexp(m, &e);
+    R g[8];
+    const R iso_scaled = R(std::ldexp(iso, -e));
+    for (int i = 0; i < 8; ++i) g[i] = R(std::ldexp(corner[i], -e)) - iso_scaled;
+
+    // 2. Monomial coefficients of the interpolant (notes 1.1) and of its restriction to the segment.
+    const R k1 = g[1] - g[0], k2 = g[2] - g[0], k3 = g[4] - g[0];
+    const R k4 = g[3] - g[1] - g[2] + g[0];   // xy
+    const R k5 = g[6] - g[2] - g[4] + g[0];   // yz
+    const R k6 = g[5] - g[1] - g[4] + g[0];   // xz
+    const R k7 = g[7] - g[3] - g[5] - g[6] + g[1] + g[2] + g[4] - g[0];
+    const R ox = R(p_in[0]), oy = R(p_in[1]), oz = R(p_in[2]);
+    const R dx = R(p_out[0]) - ox, dy = R(p_out[1]) - oy, dz = R(p_out[2]) - oz;
+
+    CellCubic<R> f;
+    f.c[0] = trilinear<R>(g, ox, oy, oz);
+    f.c[1] = k1 * dx + k2 * dy + k3 * dz + k4 * (ox * dy + oy * dx) + k5 * (oy * dz + oz * dy) +
+             k6 * (ox * dz + oz * dx) + k7 * (ox * oy * dz + ox * oz * dy + oy * oz * dx);
+    f.c[2] = k4 * dx * dy + k5 * dy * dz + k6 * dx * dz + k7 * (ox * dy * dz + oy * dx * dz + oz * dx * dy);
+    f.c[3] = k7 * dx * dy * dz;
+    f.f_out = trilinear<R>(g, R(p_out[0]), R(p_out[1]), R(p_out[2]));
+
+    // 3. Normalise so the largest magnitude lies in [1/2, 1): exact, signs and zeros preserved.
+    R big = std::fabs(f.f_out);
+    for (int i = 0; i < 4; ++i) big = std::fmax(big, std::fabs(f.c[i]));
+    int e2 = 0;
+    if (big > 0) std::frexp(big, &e2);
+    for (int i = 0; i < 4; ++i) f.c[i] = std::ldexp(f.c[i], -e2);
+    f.f_out = std::ldexp(f.f_out, -e2);
+    f.f_in = f.c[0];
+    f.scale_exp = e + e2;
+    return f;
+}
+
+}  // namespace octiso

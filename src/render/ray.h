@@ -1,0 +1,75 @@
+// Rays in world and index space and their clip to the data box, shared by the octree renderer
+// and the brute-force reference tracer so both see exactly the same interval [t_in, t_out].
+// Index space: voxel (i,j,k) at (i,j,k); the index ray keeps the world parameter t (the direction
+// is divided by the spacing and NOT renormalised), so t is world distance along the unit ray.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "octiso/volume.h"
+
+namespace octiso {
+
+/// World-space ray: origin and unit direction (CONVENTIONS 2). Components may be +-0.
+struct Ray {
+    std::array<double, 3> origin{};
+    std::array<double, 3> dir{};
+};
+
+/// The same ray in index space: p_index(t) = origin + t * dir, t the world distance.
+struct IndexRay {
+    std::array<double, 3> origin{};
+    std::array<double, 3> dir{};
+
+    /// t at which the ray crosses the plane p[axis] == plane; +inf ("never") when dir[axis] is
+    /// +0 or -0, so no 0 * inf or 0/0 ever reaches a caller.
+    double plane_t(int axis, double plane) const {
+        const double d = dir[axis];
+        if (d == 0) return std::numeric_limits<double>::infinity();
+        return (plane - origin[axis]) / d;
+    }
+};
+
+inline IndexRay index_from_world(const Ray& ray_world, const Placement& placement) {
+    IndexRay r;
+    for (int a = 0; a < 3; ++a) {
+        r.origin[a] = (ray_world.origin[a] - placement.origin[a]) / placement.spacing[a];
+        r.dir[a] = ray_world.dir[a] / placement.spacing[a];
+    }
+    return r;
+}
+
+/// The part [t_in, t_out] of the ray with t >= t_min inside the closed box [0, box_hi] (per axis).
+/// empty() when the ray misses it, any input is non-finite or the direction is zero. A ray that only touches the box
+/// (edge, corner, or lying in a face) gets t_in == t_out or a segment in the face: closed box.
+/// For each axis, the slab crossing times are exactly IndexRay::plane_t(axis, 0 or box_hi), the
+/// same expression a DDA uses for its cell faces, so callers can recognise face crossings by ==.
+struct BoxClip {
+    double t_in = std::numeric_limits<double>::infinity();
+    double t_out = -std::numeric_limits<double>::infinity();
+    bool empty() const { return !(t_in <= t_out); }
+};
+
+inline BoxClip clip_to_box(const IndexRay& ray, const std::array<double, 3>& box_hi, double t_min = 0.0) {
+    BoxClip clip;
+    double t_in = t_min, t_out = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        const double o = ray.origin[a], d = ray.dir[a];
+        if (!std::isfinite(o) || !std::isfinite(d) || !(box_hi[a] >= 0)) return clip;
+        if (d == 0) {   // parallel to the slab: inside it for all t, or never
+            if (o < 0 || o > box_hi[a]) return clip;
+            continue;
+        }
+        const double t_lo = ray.plane_t(a, d > 0 ? 0.0 : box_hi[a]);
+        const double t_hi = ray.plane_t(a, d > 0 ? box_hi[a] : 0.0);
+        t_in = std::fmax(t_in, t_lo);
+        t_out = std::fmin(t_out, t_hi);
+    }
+    if (!std::isfinite(t_in) || !std::isfinite(t_out) || !(t_in <= t_out)) return clip;   // dir == 0: no ray
+    clip.t_in = t_in, clip.t_out = t_out;
+    return clip;
+}
+
+}  // namespace octiso

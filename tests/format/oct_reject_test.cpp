@@ -1,0 +1,380 @@
+// Damaged and hostile .oct files must give an octiso::Error, never a crash or a read outside the
+// mapping: every truncation, single bit flips (Verify::Full: always an Error; IndicesOnly: an Error
+// or a view that is safe to walk), index corruption with all checksums recomputed, hostile
+// section tables (offset + size wrapping around), and bad header fields.
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <random>
+
+#include "format/oct_test_util.h"
+#include "octiso/decode.h"
+#include "octiso/error.h"
+
+namespace octiso::test {
+namespace {
+
+using format::FileHeader;
+using format::SectionEntry;
+
+/// Opens `path` and validates every step. Returns normally only if the whole file is valid;
+/// an octiso::Error propagates, anything else fails the test through gtest.
+void load_everything(const std::string& path, Verify verify) {
+    const OctFile f = OctFile::open(path, verify);
+    dispatch_scalar_type(f.info().type, [&](auto t) {
+        using T = decltype(t);
+        for (uint32_t k = 0; k < f.info().step_count; ++k) {
+            const Octree<T> tree = f.step<T>(k);
+            // Walk everything the renderer could reach: with ASan this proves the view is safe.
+            std::vector<T> out(size_t(tree.dims().voxels()));
+            decode_to_dense(tree, out.data());
+            const Dims d = tree.dims();
+            for (uint32_t z = 0; z < d.z; ++z)
+                for (uint32_t y = 0; y < d.y; ++y)
+                    for (uint32_t x = 0; x < d.x; ++x)
+                        if (!(tree.point_locate({x, y, z}) == out[x + uint64_t(d.x) * (y + uint64_t(d.y) * z)]) &&
+                            !std::isnan(double(out[x + uint64_t(d.x) * (y + uint64_t(d.y) * z)])))
+                            FAIL() << "decode and point location disagree at " << x << "," << y << "," << z;
+            for_each_node<T>(tree, [&](int, uint32_t, Coord) {});
+        }
+    });
+}
+
+bool rejected(const std::string& path, Verify verify) {
+    try {
+        load_everything(path, verify);
+        return false;
+    } catch (const Error& e) {
+        EXPECT_EQ(e.subject(), path) << e.what();   // every message names the file
+        return true;
+    }
+}
+
+/// A small valid file of two steps of u8 (dmax 4): the first of pattern `p`, the second random.
+struct Fixture {
+    ScratchDir dir;
+    std::string good = dir.file("good.oct");
+    std::string bad = dir.file("bad.oct");
+    Fixture(Pattern p = Pattern::Sparse) {
+        const auto v0 = make_volume<uint8_t>({9, 6, 5}, p, 11);
+        const auto v1 = make_volume<uint8_t>({9, 6, 5}, Pattern::Random, 12);
+        const auto b0 = build_octree(v0.view(), {});
+        const auto b1 = build_octree(v1.view(), {});
+        write_oct<uint8_t>(good, info_for(ScalarType::u8, v0.dims), {b0.view(), b1.view()});
+    }
+    /// Applies `edit` to a copy of the good file, re-checksums unless told not to, and says
+    /// whether the loader (both modes) rejects it.
+    void expect_rejected(const std::function<void(OctBytes&)>& edit, const char* what, bool rechecksum = true) {
+        OctBytes b(good);
+        edit(b);
+        if (rechecksum) b.rechecksum();
+        b.save(bad);
+        EXPECT_TRUE(rejected(bad, Verify::Full)) << what;
+        EXPECT_TRUE(rejected(bad, Verify::IndicesOnly)) << what;
+    }
+};
+
+TEST(OctReject, TheEditorItselfKeepsAGoodFileGood) {
+    Fixture fx;
+    OctBytes b(fx.good);
+    b.rechecksum();
+    b.save(fx.bad);
+    EXPECT_FALSE(rejected(fx.bad, Verify::Full));
+    EXPECT_EQ(read_bytes(fx.bad), read_bytes(fx.good));
+}
+
+TEST(OctReject, EveryTruncationIsAnError) {
+    Fixture fx;
+    const std::vector<char> bytes = read_bytes(fx.good);
+    ASSERT_GT(bytes.size(), 1000u);
+    for (size_t n = 0; n < bytes.size(); ++n) {
+        write_bytes(fx.bad, bytes.data(), n);
+        ASSERT_TRUE(rejected(fx.bad, Verify::IndicesOnly)) << "prefix of " << n << " bytes";
+    }
+    // And one byte too many.
+    std::vector<char> longer = bytes;
+    longer.push_back(0);
+    write_bytes(fx.bad, longer.data(), longer.size());
+    EXPECT_TRUE(rejected(fx.bad, Verify::Full));
+}
+
+TEST(OctReject, EverySingleBitFlipIsAnErrorWithFullVerification) {
+    Fixture fx;
+    std::vector<char> bytes = read_bytes(fx.good);
+    ASSERT_LT(bytes.size(), 8000u);   // keep the exhaustive loop small
+    for (size_t bit = 0; bit < bytes.size() * 8; ++bit) {
+        bytes[bit / 8] = char(bytes[bit / 8] ^ (1 << (bit % 8)));
+        write_bytes(fx.bad, bytes.data(), bytes.size());
+        ASSERT_TRUE(rejected(fx.bad, Verify::Full)) << "bit " << bit % 8 << " of byte " << bit / 8;
+        bytes[bit / 8] = char(bytes[bit / 8] ^ (1 << (bit % 8)));
+    }
+}
+
+TEST(OctReject, BitFlipsWithoutChecksumsGiveAnErrorOrASafeView) {
+    // The flips land in node data with the checksums recomputed, so only the index checks stand
+    // between a flip and the traversal. Each outcome must be an Error or a walkable tree.
+    for (Pattern p : {Pattern::Sparse, Pattern::Random}) {
+        Fixture fx(p);
+        OctBytes good(fx.good);
+        const FileHeader h = good.header();
+        const uint64_t data_begin = good.entry(0).offset, data_end = h.section_table_offset;
+        std::mt19937_64 rng(77);
+        int n_rejected = 0, n_valid = 0;
+        for (int trial = 0; trial < 3000; ++trial) {
+            OctBytes b = good;
+            const uint64_t byte = data_begin + rng() % (data_end - data_begin);
+            b.bytes[byte] = char(b.bytes[byte] ^ (1 << (rng() % 8)));
+            b.rechecksum();
+            b.save(fx.bad);
+            try {
+                load_everything(fx.bad, Verify::IndicesOnly);
+                ++n_valid;
+            } catch (const Error&) {
+                ++n_rejected;
+            }
+            if (::testing::Test::HasFatalFailure()) return;
+        }
+        // Both outcomes occur: flips in min/max stay valid, flips in masks and starts do not.
+        EXPECT_GT(n_rejected, 0);
+        EXPECT_GT(n_valid, 0);
+    }
+}
+
+// ---- index corruption, checksums recomputed: only the structural checks can catch these ----
+
+/// Index of the last node at `depth` of step 0 that has children.
+uint64_t last_parent(const OctBytes& b, int depth) {
+    const SectionEntry s = b.entry(b.entry_index(0, depth));
+    for (uint64_t i = s.count; i-- > 0;)
+        if (b.node<uint8_t>(0, depth, i).child_mask != 0) return i;
+    ADD_FAILURE() << "no node with children at depth " << depth;
+    return 0;
+}
+
+TEST(OctReject, ChildIndicesOutOfRangeOrOverlappingAreErrors) {
+    Fixture fx;
+    const int dmax = OctBytes(fx.good).header().dmax;
+    ASSERT_EQ(dmax, 4);
+    for (int d = 0; d <= dmax - 2; ++d) {
+        SCOPED_TRACE(d);
+        fx.expect_rejected([&](OctBytes& b) {
+            const uint64_t i = last_parent(b, d);
+            auto n = b.node<uint8_t>(0, d, i);
+            n.child_start += 1;   // past the end of the next level
+            b.set_node(0, d, i, n);
+        }, "child_start one too large");
+        fx.expect_rejected([&](OctBytes& b) {
+            const uint64_t i = last_parent(b, d);
+            auto n = b.node<uint8_t>(0, d, i);
+            n.child_start = std::numeric_limits<uint32_t>::max();   // 32-bit wrap if added in 32 bits
+            b.set_node(0, d, i, n);
+        }, "child_start at the 32-bit limit");
+        fx.expect_rejected([&](OctBytes& b) {
+            const uint64_t i = last_parent(b, d);
+            auto n = b.node<uint8_t>(0, d, i);
+            ASSERT_NE(n.child_mask, 0xff) << "fixture needs a node with a leaf child";
+            n.child_mask = uint8_t(n.child_mask | (n.child_mask + 1));   // one more child bit
+            b.set_node(0, d, i, n);
+        }, "child_mask with too many bits");
+        fx.expect_rejected([&](OctBytes& b) {
+            const uint64_t i = last_parent(b, d);
+            auto n = b.node<uint8_t>(0, d, i);
+            n.child_mask = uint8_t(n.child_mask & (n.child_mask - 1));   // one child bit fewer
+            b.set_node(0, d, i, n);
+        }, "child_mask with too few bits (a node below loses its parent)");
+        fx.expect_rejected([&](OctBytes& b) {
+            auto n = b.node<uint8_t>(0, d, 0);
+            n.reserved[1] = 1;
+            b.set_node(0, d, 0, n);
+        }, "reserved byte set");
+    }
+}
+
+TEST(OctReject, MessagesNameFileStepDepthNodeAndNumbers) {
+    Fixture fx;
+    OctBytes b(fx.good);
+    auto root = b.node<uint8_t>(1, 0, 0);
+    const uint64_t below = b.entry(b.entry_index(1, 1)).count;
+    root.child_start = uint32_t(below);   // every child past the end of depth 1
+    b.set_node(1, 0, 0, root);
+    b.rechecksum();
+    b.save(fx.bad);
+    const OctFile f = OctFile::open(fx.bad, Verify::IndicesOnly);
+    EXPECT_NO_THROW(f.step<uint8_t>(0));   // the other step is fine
+    try {
+        f.step<uint8_t>(1);
+        FAIL() << "corrupt step accepted";
+    } catch (const Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find(fx.bad), std::string::npos) << m;
+        EXPECT_NE(m.find("step 1, depth 0"), std::string::npos) << m;
+        EXPECT_NE(m.find("node 0"), std::string::npos) << m;
+        EXPECT_NE(m.find("expected <= " + std::to_string(below)), std::string::npos) << m;
+    }
+    // A failed step stays failed on the next request.
+    EXPECT_THROW(f.step<uint8_t>(1), Error);
+}
+
+TEST(OctReject, OverlappingChildrenAreErrors) {
+    Fixture fx(Pattern::Random);
+    fx.expect_rejected([&](OctBytes& b) {
+        // Two parents at depth 1 pointing at the same children: overlap.
+        const SectionEntry s = b.entry(b.entry_index(0, 1));
+        std::vector<uint64_t> parents;
+        for (uint64_t i = 0; i < s.count; ++i)
+            if (b.node<uint8_t>(0, 1, i).child_mask) parents.push_back(i);
+        ASSERT_GE(parents.size(), 2u);
+        auto n = b.node<uint8_t>(0, 1, parents[1]);
+        n.child_start = b.node<uint8_t>(0, 1, parents[0]).child_start;
+        b.set_node(0, 1, parents[1], n);
+    }, "overlapping children");
+}
+
+TEST(OctReject, BadCountsAreErrors) {
+    Fixture fx;
+    fx.expect_rejected([](OctBytes& b) {
+        SectionEntry s = b.entry(b.entry_index(1, 3));
+        s.count -= 1;   // bytes no longer count * record size
+        b.set_entry(b.entry_index(1, 3), s);
+    }, "count without bytes");
+    fx.expect_rejected([](OctBytes& b) {
+        // Shrink the last cap section consistently and move the table: the parents now point
+        // past the end of the caps.
+        const uint64_t last = b.section_count() - 1;
+        SectionEntry s = b.entry(last);
+        ASSERT_GE(s.count, 2u);
+        FileHeader h = b.header();
+        std::vector<char> table(b.bytes.begin() + long(h.section_table_offset), b.bytes.end());
+        s.count -= 1;
+        s.bytes -= s.record_bytes;
+        std::memcpy(table.data() + last * sizeof s, &s, sizeof s);
+        const uint64_t new_table = format::align_up(s.offset + s.bytes);
+        b.bytes.resize(new_table);
+        std::fill(b.bytes.begin() + long(s.offset + s.bytes), b.bytes.end(), 0);
+        b.bytes.insert(b.bytes.end(), table.begin(), table.end());
+        h.section_table_offset = new_table;
+        h.file_bytes = b.bytes.size();
+        b.set_header(h);
+    }, "one cap fewer than the parents need");
+    fx.expect_rejected([](OctBytes& b) {
+        SectionEntry s = b.entry(0);
+        s.count = 2;
+        s.bytes = 2 * uint64_t(s.record_bytes);
+        b.set_entry(0, s);
+    }, "two roots");
+    fx.expect_rejected([](OctBytes& b) {
+        SectionEntry s = b.entry(0);
+        s.count = 0;
+        s.bytes = 0;
+        b.set_entry(0, s);
+    }, "no root");
+}
+
+TEST(OctReject, HostileSectionTablesAreErrors) {
+    Fixture fx;
+    const uint64_t kMax = std::numeric_limits<uint64_t>::max();
+    for (uint64_t i : {uint64_t(0), uint64_t(2), uint64_t(7)}) {
+        SCOPED_TRACE(i);
+        fx.expect_rejected([&](OctBytes& b) {
+            SectionEntry s = b.entry(i);
+            s.offset = kMax - 5;   // offset + bytes wraps around to a small number
+            b.set_entry(i, s);
+        }, "offset near 2^64");
+        fx.expect_rejected([&](OctBytes& b) {
+            SectionEntry s = b.entry(i);
+            s.bytes = kMax - s.offset + 1 + 64;   // wraps to 64
+            b.set_entry(i, s);
+        }, "bytes that wrap");
+        fx.expect_rejected([&](OctBytes& b) {
+            SectionEntry s = b.entry(i);
+            // count * record wraps around to the real byte size.
+            s.count = s.count + (uint64_t(1) << 63) / (s.record_bytes & -s.record_bytes) * 2;
+            b.set_entry(i, s);
+        }, "count * record size that wraps");
+        fx.expect_rejected([&](OctBytes& b) {
+            SectionEntry s = b.entry(i);
+            s.offset += 64;
+            b.set_entry(i, s);
+        }, "section moved off its canonical offset");
+        fx.expect_rejected([&](OctBytes& b) {
+            SectionEntry s = b.entry(i);
+            s.depth ^= 1;
+            b.set_entry(i, s);
+        }, "duplicate (step, depth)");
+        fx.expect_rejected([&](OctBytes& b) {
+            SectionEntry s = b.entry(i);
+            s.kind = s.kind == 1 ? 2 : 1;
+            b.set_entry(i, s);
+        }, "wrong kind");
+        fx.expect_rejected([&](OctBytes& b) {
+            SectionEntry s = b.entry(i);
+            s.record_bytes += 1;
+            b.set_entry(i, s);
+        }, "wrong record size");
+    }
+    fx.expect_rejected([&](OctBytes& b) {
+        FileHeader h = b.header();
+        h.section_table_offset = kMax - 10;
+        b.set_header(h);
+    }, "table offset near 2^64");
+    fx.expect_rejected([&](OctBytes& b) {
+        FileHeader h = b.header();
+        h.section_count = kMax / sizeof(SectionEntry) + 2;   // count * 48 wraps
+        b.set_header(h);
+    }, "table size that wraps");
+    fx.expect_rejected([&](OctBytes& b) {
+        // Nonzero padding between sections would escape every checksum.
+        for (uint64_t i = 1; i < b.section_count(); ++i)
+            if (b.entry(i - 1).offset + b.entry(i - 1).bytes < b.entry(i).offset) {
+                b.bytes[b.entry(i).offset - 1] = 1;
+                return;
+            }
+        FAIL() << "fixture has no padding between sections";
+    }, "padding not zero");
+}
+
+TEST(OctReject, BadHeaderFieldsAreErrors) {
+    Fixture fx;
+    auto header_edit = [&](const char* what, const std::function<void(FileHeader&)>& f, bool rechecksum = true) {
+        fx.expect_rejected([&](OctBytes& b) {
+            FileHeader h = b.header();
+            f(h);
+            b.set_header(h);
+        }, what, rechecksum);
+    };
+    header_edit("magic", [](FileHeader& h) { h.magic[0] = 'X'; });
+    header_edit("version", [](FileHeader& h) { h.version = format::kFormatVersion + 1; });
+    header_edit("header size", [](FileHeader& h) { h.header_bytes = 128; });
+    header_edit("endianness", [](FileHeader& h) { h.endian_tag = __builtin_bswap32(format::kEndianTag); });
+    header_edit("header checksum", [](FileHeader& h) { h.tolerance = 1.0; }, false);
+    header_edit("scalar type code", [](FileHeader& h) { h.scalar_type = 8; });
+    header_edit("wider scalar type", [](FileHeader& h) { h.scalar_type = uint8_t(ScalarType::u16); h.scalar_bytes = 2; });
+    header_edit("scalar size", [](FileHeader& h) { h.scalar_bytes = 2; });
+    header_edit("zero extent", [](FileHeader& h) { h.dims[1] = 0; });
+    header_edit("huge extent", [](FileHeader& h) { h.dims[2] = Dims::kMaxExtent + 1; });
+    header_edit("dims not matching dmax", [](FileHeader& h) { h.dims[0] = 100; });
+    header_edit("dmax", [](FileHeader& h) { h.dmax = 5; });
+    header_edit("no steps", [](FileHeader& h) { h.step_count = 0; });
+    header_edit("more steps than sections", [](FileHeader& h) { h.step_count = 3; });
+    header_edit("fewer steps than sections", [](FileHeader& h) { h.step_count = 1; });
+    header_edit("iso-range flag", [](FileHeader& h) { h.has_iso_range = 2; });
+    header_edit("iso-range order", [](FileHeader& h) { std::swap(h.iso_range[0], h.iso_range[1]); });
+    header_edit("spacing NaN", [](FileHeader& h) { h.spacing[0] = std::nan(""); });
+    header_edit("spacing zero", [](FileHeader& h) { h.spacing[2] = 0.0; });
+    header_edit("origin inf", [](FileHeader& h) { h.origin[1] = INFINITY; });
+    header_edit("tolerance negative", [](FileHeader& h) { h.tolerance = -1.0; });
+    header_edit("file size", [](FileHeader& h) { h.file_bytes += 64; });
+    header_edit("entry size", [](FileHeader& h) { h.section_entry_bytes = 64; });
+    header_edit("reserved", [](FileHeader& h) { h.reserved[40] = 1; });
+}
+
+TEST(OctReject, NonFilesAndEmptyFilesAreErrors) {
+    ScratchDir dir;
+    EXPECT_THROW(OctFile::open(dir.file("missing.oct")), Error);
+    EXPECT_THROW(OctFile::open(dir.file("")), Error);   // the directory itself
+    write_bytes(dir.file("empty.oct"), "", 0);
+    EXPECT_THROW(OctFile::open(dir.file("empty.oct")), Error);
+}
+
+}  // namespace
+}  // namespace octiso::test
