@@ -7,11 +7,9 @@ packages=(
   build-essential cmake pkg-config
   libtbb-dev libembree-dev libopenimageio-dev openimageio-tools libvtk9-dev
   libgtest-dev libbenchmark-dev libxxhash-dev zstd libzstd-dev
+  libopenvdb-dev libboost-iostreams-dev mricron-data
   python3-numpy python3-matplotlib
 )
-if [[ "${OCTISO_PEERS:-0}" == 1 ]]; then
-  packages+=(libopenvdb-dev libboost-iostreams-dev mricron-data)
-fi
 
 missing=()
 for p in "${packages[@]}"; do
