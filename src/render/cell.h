@@ -8,6 +8,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace octiso {
 
@@ -32,6 +34,20 @@ inline std::array<double, 3> gradient(const double c[8], const std::array<double
     const double dy = cell_lerp(cell_lerp(c[2] - c[0], c[3] - c[1], x), cell_lerp(c[6] - c[4], c[7] - c[5], x), z);
     const double dz = cell_lerp(cell_lerp(c[4] - c[0], c[5] - c[1], x), cell_lerp(c[6] - c[2], c[7] - c[3], x), y);
     return {dx, dy, dz};
+}
+
+/// x * 2^e, exactly as std::ldexp rounds it, but as one multiplication by an exact power of two
+/// when that factor is a normal number (the hot case: ldexp is a library call). Both round only
+/// where the result leaves the normal range, and then identically.
+template <typename R> inline R scale_by_power_of_two(R x, int e) {
+    if (e > -1000 && e < 1000) {
+        // Build 2^e from its bit pattern: exact, no call.
+        const uint64_t bits = uint64_t(e + 1023) << 52;
+        double factor;
+        std::memcpy(&factor, &bits, sizeof factor);
+        return x * R(factor);
+    }
+    return std::ldexp(x, e);
 }
 
 /// f(s) = c[0] + c[1] s + c[2] s^2 + c[3] s^3 = (trilinear(p_in + s (p_out - p_in)) - iso) * 2^-scale_exp.
@@ -62,8 +78,8 @@ inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const st
     int e = 0;
     if (m > 0) std::frexp(m, &e);
     R g[8];
-    const R iso_scaled = R(std::ldexp(iso, -e));
-    for (int i = 0; i < 8; ++i) g[i] = R(std::ldexp(corner[i], -e)) - iso_scaled;
+    const R iso_scaled = R(scale_by_power_of_two(iso, -e));
+    for (int i = 0; i < 8; ++i) g[i] = R(scale_by_power_of_two(corner[i], -e)) - iso_scaled;
 
     // 2. Monomial coefficients of the interpolant (notes 1.1) and of its restriction to the segment.
     const R k1 = g[1] - g[0], k2 = g[2] - g[0], k3 = g[4] - g[0];
@@ -87,8 +103,8 @@ inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const st
     for (int i = 0; i < 4; ++i) big = std::fmax(big, std::fabs(f.c[i]));
     int e2 = 0;
     if (big > 0) std::frexp(big, &e2);
-    for (int i = 0; i < 4; ++i) f.c[i] = std::ldexp(f.c[i], -e2);
-    f.f_out = std::ldexp(f.f_out, -e2);
+    for (int i = 0; i < 4; ++i) f.c[i] = scale_by_power_of_two(f.c[i], -e2);
+    f.f_out = scale_by_power_of_two(f.f_out, -e2);
     f.f_in = f.c[0];
     f.scale_exp = e + e2;
     return f;

@@ -22,22 +22,36 @@ struct Ray {
 struct IndexRay {
     std::array<double, 3> origin{};
     std::array<double, 3> dir{};
+    std::array<double, 3> inv_dir{};   ///< 1/dir, 0 where dir is +-0 (never used there)
 
     /// t at which the ray crosses the plane p[axis] == plane; +inf ("never") when dir[axis] is
-    /// +0 or -0, so no 0 * inf or 0/0 ever reaches a caller.
+    /// +0 or -0, so no 0 * inf or 0/0 ever reaches a caller. A multiplication by the reciprocal,
+    /// not a division: every tracer calls this one function, so all agree on each boundary t.
     double plane_t(int axis, double plane) const {
-        const double d = dir[axis];
-        if (d == 0) return std::numeric_limits<double>::infinity();
-        return (plane - origin[axis]) / d;
+        if (dir[axis] == 0) return std::numeric_limits<double>::infinity();
+        return (plane - origin[axis]) * inv_dir[axis];
+    }
+
+    static IndexRay make(const std::array<double, 3>& o, const std::array<double, 3>& d) {
+        IndexRay r;
+        r.origin = o;
+        r.set_direction(d);
+        return r;
+    }
+    void set_direction(const std::array<double, 3>& d) {
+        dir = d;
+        for (int a = 0; a < 3; ++a) inv_dir[a] = d[a] == 0 ? 0.0 : 1.0 / d[a];
     }
 };
 
 inline IndexRay index_from_world(const Ray& ray_world, const Placement& placement) {
     IndexRay r;
+    std::array<double, 3> d;
     for (int a = 0; a < 3; ++a) {
         r.origin[a] = (ray_world.origin[a] - placement.origin[a]) / placement.spacing[a];
-        r.dir[a] = ray_world.dir[a] / placement.spacing[a];
+        d[a] = ray_world.dir[a] / placement.spacing[a];
     }
+    r.set_direction(d);
     return r;
 }
 

@@ -363,7 +363,7 @@ TEST(BruteForce, CurvedFieldMatchesAFineMarchFromAnInsideEye) {
 
 TEST(RayClip, SignedZeroAndDegenerateBoxes) {
     const double z = 0.0;
-    IndexRay r{{-1, 2, 3}, {1, -z, z}};
+    IndexRay r = IndexRay::make({-1, 2, 3}, {1, -z, z});
     BoxClip clip = clip_to_box(r, {4, 4, 4});
     EXPECT_EQ(clip.t_in, 1.0);
     EXPECT_EQ(clip.t_out, 5.0);
@@ -372,11 +372,11 @@ TEST(RayClip, SignedZeroAndDegenerateBoxes) {
     EXPECT_FALSE(clip.empty());
     r.origin = {-1, std::nextafter(4.0, 5.0), 0};
     EXPECT_TRUE(clip_to_box(r, {4, 4, 4}).empty());
-    r = IndexRay{{2, 2, 2}, {-1, 0, 0}};   // origin inside: t_in clamps to 0
+    r = IndexRay::make({2, 2, 2}, {-1, 0, 0});   // origin inside: t_in clamps to 0
     clip = clip_to_box(r, {4, 4, 4});
     EXPECT_EQ(clip.t_in, 0.0);
     EXPECT_EQ(clip.t_out, 2.0);
-    EXPECT_TRUE(clip_to_box(IndexRay{{2, 2, 2}, {0, 0, 0}}, {4, 4, 4}).empty());
+    EXPECT_TRUE(clip_to_box(IndexRay::make({2, 2, 2}, {0, 0, 0}), {4, 4, 4}).empty());
     EXPECT_EQ(r.plane_t(1, 3.0), kInf);
     Placement pl;
     pl.spacing = {2, 4, 0.5};
