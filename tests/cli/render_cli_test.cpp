@@ -1,0 +1,152 @@
+// octiso-render end to end (CONVENTIONS 2-3): the image and AOV files it writes, --json as exactly
+// one object on stdout, and exit status 2 with no output file left for every bad input or usage.
+// Skipped when the tools are not built next to the tests.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "octiso/image.h"
+
+namespace octiso::test {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kTools = OCTISO_TOOLS_DIR;
+
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        static int n = 0;
+        path = fs::temp_directory_path() / ("octiso_render_cli_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
+        fs::create_directories(path);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    std::string file(const std::string& name) const { return (path / name).string(); }
+    size_t entries() const { return size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator())); }
+};
+
+int run(const std::string& tool, const std::string& args, std::string* out = nullptr, std::string* err = nullptr) {
+    static int n = 0;
+    const std::string err_file = (fs::temp_directory_path() / ("octiso_err_" + std::to_string(::getpid()) + "_" + std::to_string(n++))).string();
+    const std::string cmd = "'" + kTools + "/" + tool + "' " + args + " 2>'" + err_file + "'";
+    std::FILE* p = ::popen(cmd.c_str(), "r");
+    if (!p) return -1;
+    std::string text;
+    char buf[4096];
+    size_t k;
+    while ((k = std::fread(buf, 1, sizeof buf, p)) > 0) text.append(buf, k);
+    const int status = ::pclose(p);
+    if (out) *out = text;
+    if (err) {
+        std::FILE* f = std::fopen(err_file.c_str(), "r");
+        err->clear();
+        while (f && (k = std::fread(buf, 1, sizeof buf, f)) > 0) err->append(buf, k);
+        if (f) std::fclose(f);
+    }
+    std::remove(err_file.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+class RenderCli : public ::testing::Test {
+protected:
+    void SetUp() override {
+        if (!fs::exists(kTools + "/octiso-render") || !fs::exists(kTools + "/octiso-convert")) GTEST_SKIP() << "tools not built";
+        ASSERT_EQ(run("octiso-convert", "--synthetic sphere:24 -o '" + oct_ + "'"), 0);
+        ASSERT_EQ(run("octiso-convert", "--synthetic marschner-lobb:20 --iso-range 0.3,0.7 -o '" + ranged_ + "'"), 0);
+    }
+    TempDir inputs_;
+    std::string oct_ = inputs_.file("sphere.oct"), ranged_ = inputs_.file("ml.oct");
+};
+
+TEST_F(RenderCli, WritesColourDepthAndNormalImagesAndOneJsonObject) {
+    TempDir out;
+    std::string json;
+    const std::string args = "'" + oct_ + "' --iso 5 --size 40x30 -o '" + out.file("c.png") + "' --depth '" +
+                             out.file("d.exr") + "' --normal '" + out.file("n.exr") + "' --json";
+    ASSERT_EQ(run("octiso-render", args, &json), 0);
+    // Exactly one JSON object on stdout.
+    const size_t first = json.find_first_not_of(" \n"), last = json.find_last_not_of(" \n");
+    ASSERT_NE(first, std::string::npos);
+    EXPECT_EQ(json[first], '{');
+    EXPECT_EQ(json[last], '}');
+    EXPECT_NE(json.find("\"seconds\""), std::string::npos);
+    EXPECT_NE(json.find("\"mrays_per_second\""), std::string::npos);
+    EXPECT_NE(json.find("\"hits\""), std::string::npos);
+
+    const FloatImage c = read_image(out.file("c.png"));
+    EXPECT_EQ(c.width, 40);
+    EXPECT_EQ(c.height, 30);
+    EXPECT_EQ(c.channels, 3);
+    const FloatImage d = read_image(out.file("d.exr"));
+    ASSERT_EQ(d.channels, 1);
+    EXPECT_EQ(d.channel_names[0], "Z");
+    const FloatImage n = read_image(out.file("n.exr"));
+    ASSERT_EQ(n.channels, 3);
+    int hits = 0, misses = 0;
+    for (int i = 0; i < d.width * d.height; ++i) {
+        if (std::isfinite(d.pixels[size_t(i)])) {
+            ++hits;
+            const float* v = &n.pixels[3 * size_t(i)];
+            EXPECT_NEAR(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]), 1.0, 1e-5) << "hit normals are unit";
+        } else {
+            ++misses;
+            EXPECT_EQ(n.pixels[3 * size_t(i)], 0.0f);
+        }
+    }
+    EXPECT_GT(hits, 0);
+    EXPECT_GT(misses, 0);
+}
+
+TEST_F(RenderCli, BadInputsExitTwoAndLeaveNoOutput) {
+    TempDir out;
+    const std::string png = "-o '" + out.file("x.png") + "'";
+    const std::vector<std::string> bad = {
+        "'" + oct_ + "' " + png,                                                    // no --iso
+        "'" + oct_ + "' --iso 5",                                                   // no output at all
+        "'" + oct_ + "' --iso abc " + png,                                          // not a number
+        "'" + out.file("missing.oct") + "' --iso 5 " + png,                         // no such file
+        "'" + oct_ + "' --iso 5 -o '" + out.file("x.unknownext") + "'",             // no image format
+        "'" + oct_ + "' --iso 5 --size 0x10 " + png,                                // bad size
+        "'" + oct_ + "' --iso 5 --eye 1,2,3 --look 1,2,3 " + png,                   // eye == look
+        "'" + oct_ + "' --iso 5 --up 0,0,0 " + png,                                 // zero up
+        "'" + oct_ + "' --iso 5 --root-finder newton " + png,                       // unknown finder
+        "'" + oct_ + "' --iso 5 --frobnicate " + png,                               // unknown flag
+        "'" + oct_ + "' --iso 5 --steps 0:3 -o '" + out.file("f_%03d.png") + "'",   // steps out of range
+        "'" + ranged_ + "' --iso 0.9 " + png,                                       // outside the iso-range
+        "'" + ranged_ + "' --iso 0.3 " + png,                                       // the range's own end
+    };
+    for (const std::string& args : bad) {
+        std::string err;
+        EXPECT_EQ(run("octiso-render", args, nullptr, &err), 2) << args;
+        EXPECT_EQ(out.entries(), 0u) << "no output, no temporary left: " << args;
+        EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << "one line on stderr: " << err;
+    }
+}
+
+TEST_F(RenderCli, IsovalueInsideTheIsoRangeRenders) {
+    TempDir out;
+    EXPECT_EQ(run("octiso-render", "'" + ranged_ + "' --iso 0.5 --size 16x16 -o '" + out.file("ok.png") + "'"), 0);
+    EXPECT_TRUE(fs::exists(out.file("ok.png")));
+}
+
+TEST_F(RenderCli, CorruptFileIsRejectedCleanly) {
+    TempDir out;
+    const std::string bad = out.file("bad.oct");
+    fs::copy_file(oct_, bad);
+    fs::resize_file(bad, fs::file_size(bad) / 2);
+    std::string err;
+    EXPECT_EQ(run("octiso-render", "'" + bad + "' --iso 5 -o '" + out.file("x.png") + "'", nullptr, &err), 2);
+    EXPECT_NE(err.find("bad.oct"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(out.file("x.png")));
+}
+
+}  // namespace
+}  // namespace octiso::test
