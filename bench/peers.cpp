@@ -1,0 +1,424 @@
+// octiso-bench peers (issue 5, item 2): octiso against the renderers a user would otherwise pick,
+// on the same volume, isovalue and primary rays (PinholeCamera, CONVENTIONS 2): VTK flying edges
+// -> Embree triangle BVH, OpenVDB (float grid bytes; level-set tracing of the shifted and scaled
+// field), and octiso's lossless octree. Every image is compared with the exact dense reference
+// (CONVENTIONS 4) and the issue's targets are printed as measured ratios.
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "bench/bench.h"
+#include "bench/peers_mesh.h"
+#include "bench/peers_vdb.h"
+#include "octiso/build.h"
+#include "octiso/error.h"
+#include "octiso/oct_file.h"
+#include "octiso/reader.h"
+#include "octiso/render.h"
+#include "octiso/synthetic.h"
+#include "reference/reference_render.h"
+
+namespace octiso::bench {
+namespace {
+
+const char* kUsage =
+    "usage: octiso-bench peers [--dataset NAME[,NAME...]] [--size N] [--image WxH] [--iso V] [--repeats N]\n"
+    "                          [--threads N] [--mri FILE] [--bvh-quality both|medium|high]\n"
+    "                          [--mesh-normals geometric|vertex] [--quick] [--markdown] [--no-plot]\n"
+    "  NAME: plume, mixing (synthetic, N^3, default 256) or mri (default /usr/share/mricron/templates/ch2.nii.gz)\n"
+    "  --image: the frame, default 512x512; --quick: 128^3 synthetic, 256x256 frame, 1 repeat\n"
+    "  --mesh-normals: the mesh shades with the triangle's geometric normal (default: cheaper, and closer to the\n"
+    "  exact normal on these data) or with flying edges' interpolated vertex normals";
+
+/// Default isovalues: half-integers, so no voxel of these integer-valued data sets lies exactly on
+/// the surface and no method is judged on a tie.
+double default_iso(const std::string& dataset) {
+    if (dataset == "plume") return 40.5;
+    if (dataset == "mixing") return 127.5;
+    return 80.5;   // ch2: white/grey matter boundary region of the MNI template
+}
+
+struct OctisoResult {
+    double build_seconds = 0;          ///< one-off conversion (not per isovalue)
+    uint64_t file_bytes = 0;
+    double load_seconds = 0;           ///< OctFile::open + step validation (page cache warm)
+    double first_render_seconds = 0;   ///< wall time of a whole render() call
+    double render_seconds = 0;         ///< median tile-loop time
+    Frame frame;
+};
+
+template <typename T>
+OctisoResult run_octiso(const LoadedVolume& volume, double iso, double warm_iso, const Camera& camera, int repeats,
+                        int threads, const std::string& oct_path) {
+    OctisoResult r;
+    {
+        BuildOptions options;
+        options.threads = threads;
+        options.source_name = volume.source();
+        const auto t0 = std::chrono::steady_clock::now();
+        const OctreeData<T> tree = build_octree(volume.view<T>(), options);
+        r.build_seconds = seconds_since(t0);
+        OctInfo info;
+        info.type = volume.type();
+        info.dims = volume.dims();
+        info.placement = volume.placement();
+        info.dmax = tree.dmax;
+        OctWriter writer(oct_path, info);
+        writer.add_step(tree.view());
+        writer.finish();
+    }
+    r.file_bytes = std::filesystem::file_size(oct_path);
+
+    auto t0 = std::chrono::steady_clock::now();
+    const OctFile file = OctFile::open(oct_path);   // Verify::Full: every checksum and index
+    const Octree<T> tree = file.step<T>(0);
+    r.load_seconds = seconds_since(t0);
+
+    RenderOptions options;
+    options.isovalues = {iso};
+    options.want_colour = false;   // every method delivers depth + normal, none shades
+    options.want_depth = true;
+    options.want_normal = true;
+    options.threads = threads;
+    // "After an isovalue change": one frame at another isovalue first, as in a running viewer.
+    RenderOptions warm = options;
+    warm.isovalues = {warm_iso};
+    (void)render(tree, file.info().placement, camera, warm);
+    t0 = std::chrono::steady_clock::now();
+    r.frame = render(tree, file.info().placement, camera, options);
+    r.first_render_seconds = seconds_since(t0);
+    std::vector<double> seconds;
+    for (int k = 0; k < std::max(repeats, 1); ++k) seconds.push_back(render(tree, file.info().placement, camera, options).stats.seconds);
+    std::sort(seconds.begin(), seconds.end());
+    r.render_seconds = seconds[seconds.size() / 2];
+    return r;
+}
+
+std::string percent(double f) { return fmt(100.0 * f, 3) + " %"; }
+std::string mb(uint64_t bytes) { return fmt(double(bytes) / 1e6, 2); }
+std::string depth_cell(const ImageError& e) { return fmt(e.depth_median, 3) + " / " + fmt(e.depth_p99, 3) + " / " + fmt(e.depth_max, 2); }
+std::string normal_cell(const ImageError& e) { return fmt(e.normal_median_deg, 2) + " / " + fmt(e.normal_max_deg, 1); }
+
+void write_error(cli::JsonWriter& j, const ImageError& e) {
+    j.key("error").begin_object();
+    j.field("mask_mismatch", e.mask_mismatch).field("mask_mismatch_fraction", e.mask_mismatch_fraction).field("both_hit", e.both_hit);
+    j.field("depth_median_voxels", e.depth_median).field("depth_p99_voxels", e.depth_p99).field("depth_max_voxels", e.depth_max);
+    j.field("normal_median_deg", e.normal_median_deg).field("normal_max_deg", e.normal_max_deg);
+    j.end_object();
+}
+
+/// One method's numbers, as printed and as written to JSON.
+struct Row {
+    std::string method;
+    double prep_seconds = NAN, bvh_seconds = NAN, render_seconds = NAN, ttfi_seconds = NAN;
+    uint64_t bytes = 0;
+    std::optional<ImageError> error;
+    std::string note;
+};
+
+struct Target {
+    std::string name;
+    double measured = 0, goal = 0;   ///< both as "higher is better" ratios
+    std::string how;
+};
+
+struct DatasetResult {
+    std::string name, source, type;
+    Dims dims;
+    double iso = 0;
+    uint64_t raw_bytes = 0;
+    double reference_seconds = 0;
+    std::vector<Row> rows;
+    std::vector<Target> targets;
+    std::vector<std::string> notes;
+};
+
+/// An isovalue a quarter of the way from `iso` to the data maximum (or minimum): a different,
+/// non-empty surface for the warm-up frames.
+double warm_up_iso(const LoadedVolume& volume, double iso) {
+    double lo = INFINITY, hi = -INFINITY;
+    dispatch_scalar_type(volume.type(), [&](auto tag) {
+        using T = decltype(tag);
+        const VolumeView<T> view = volume.view<T>();
+        for (uint64_t i = 0; i < volume.dims().voxels(); ++i) {
+            const double v = double(view.load(i));
+            if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+        }
+    });
+    return hi - iso >= iso - lo ? iso + 0.25 * (hi - iso) : iso - 0.25 * (iso - lo);
+}
+
+LoadedVolume open_dataset(const std::string& name, uint32_t n, const std::string& mri_path) {
+    if (name == "plume" || name == "mixing") return synthetic_step(name, Dims{n, n, n}, 0);
+    if (name == "mri") return open_volume(mri_path, RawOptions{});
+    throw Error("--dataset", "expected plume, mixing or mri, found '" + name + "'");
+}
+
+DatasetResult run_dataset(const std::string& name, const LoadedVolume& volume, double iso, const Camera& camera, int repeats,
+                          int threads, const std::vector<BvhQuality>& qualities, bool vertex_normals) {
+    DatasetResult d;
+    d.name = name;
+    d.source = volume.source();
+    d.type = std::string(scalar_type_name(volume.type()));
+    d.dims = volume.dims();
+    d.iso = iso;
+    d.raw_bytes = volume.bytes();
+    const Placement& placement = volume.placement();
+    const double voxel = std::min({placement.spacing[0], placement.spacing[1], placement.spacing[2]});
+    std::cerr << "== " << name << " (" << d.source << ", " << d.type << " " << d.dims.x << "x" << d.dims.y << "x" << d.dims.z
+              << "), iso " << iso << ", " << camera.width << "x" << camera.height << "\n";
+
+    // The exact answer every method is judged against.
+    const auto t0 = std::chrono::steady_clock::now();
+    const Frame reference = dispatch_scalar_type(volume.type(), [&](auto tag) {
+        using T = decltype(tag);
+        return render_reference(volume.view<T>(), placement, camera, std::vector<double>{iso});
+    });
+    d.reference_seconds = seconds_since(t0);
+    std::cerr << "  reference frame " << fmt(d.reference_seconds) << " s\n";
+
+    // Every method renders once at another isovalue before the timed one, so "first image" means
+    // the first image after an isovalue change in a warm process, for all of them alike.
+    const double warm_iso = warm_up_iso(volume, iso);
+    d.notes.push_back("first image = the first frame after a warm-up frame (and for the mesh and OpenVDB the whole "
+                      "preprocessing) at isovalue " + fmt(warm_iso, 3));
+
+    // (c) octiso.
+    const std::string oct_path = (std::filesystem::temp_directory_path() /
+                                  ("octiso-bench-peers-" + std::to_string(::getpid()) + "-" + name + ".oct")).string();
+    OctisoResult oct;
+    try {
+        oct = dispatch_scalar_type(volume.type(), [&](auto tag) {
+            return run_octiso<decltype(tag)>(volume, iso, warm_iso, camera, repeats, threads, oct_path);
+        });
+    } catch (...) {
+        std::filesystem::remove(oct_path);
+        throw;
+    }
+    std::filesystem::remove(oct_path);
+    std::cerr << "  octiso: render " << fmt(oct.render_seconds) << " s\n";
+    {
+        Row row;
+        row.method = "octiso (lossless .oct)";
+        row.prep_seconds = oct.load_seconds;
+        row.render_seconds = oct.render_seconds;
+        row.ttfi_seconds = oct.first_render_seconds;
+        row.bytes = oct.file_bytes;
+        row.error = compare_frames(oct.frame, reference, voxel);
+        row.note = "prep = load + validate; octree build (once per volume) " + fmt(oct.build_seconds) + " s";
+        d.rows.push_back(row);
+    }
+
+    // (a) flying edges -> Embree. One untimed pass at the warm-up isovalue first, so that neither
+    // build quality pays the process's first Embree device and first large allocations.
+    std::vector<MeshPeerResult> meshes;
+    {
+        MeshPeerOptions warm;
+        warm.quality = qualities.front();
+        warm.repeats = 1;
+        warm.threads = threads;
+        (void)run_mesh_peer(volume, warm_iso, camera, warm);
+    }
+    for (BvhQuality q : qualities) {
+        MeshPeerOptions options;
+        options.quality = q;
+        options.vertex_normals = vertex_normals;
+        options.repeats = repeats;
+        options.threads = threads;
+        MeshPeerResult m = run_mesh_peer(volume, iso, camera, options);
+        std::cerr << "  mesh (" << bvh_quality_name(q) << "): " << m.triangles << " triangles, extract " << fmt(m.extract_seconds)
+                  << " s, BVH " << fmt(m.bvh_seconds) << " s, render " << fmt(m.render_seconds) << " s\n";
+        Row row;
+        row.method = "FE + Embree (" + bvh_quality_name(q) + ")";
+        row.prep_seconds = m.extract_seconds;
+        row.bvh_seconds = m.bvh_seconds;
+        row.render_seconds = m.render_seconds;
+        row.ttfi_seconds = m.time_to_first_image();
+        row.bytes = m.mesh_bytes + m.bvh_bytes;
+        row.error = compare_frames(m.frame, reference, voxel);
+        const ImageError geometric = compare_frames(m.frame_geometric, reference, voxel);
+        row.note = std::to_string(m.triangles) + " triangles, mesh " + mb(m.mesh_bytes) + " MB + BVH " + mb(m.bvh_bytes) +
+                   " MB; " + (vertex_normals ? "interpolated vertex normals (geometric normal error: " + normal_cell(geometric) + " deg)"
+                                             : std::string("geometric normals"));
+        d.rows.push_back(row);
+        meshes.push_back(std::move(m));
+    }
+
+    // (b) OpenVDB.
+    (void)run_vdb_peer(volume, warm_iso, camera, 1);   // warm-up, as above
+    VdbPeerResult vdb = run_vdb_peer(volume, iso, camera, repeats);
+    if (vdb.ran) {
+        std::cerr << "  openvdb: level set " << fmt(vdb.levelset_seconds) << " s, render " << fmt(vdb.render_seconds) << " s\n";
+        Row dense;
+        dense.method = "OpenVDB float grid (bytes only)";
+        dense.prep_seconds = vdb.dense_seconds;
+        dense.bytes = vdb.dense_bytes;
+        dense.note = "copyFromDense tolerance 0, background = data minimum; " + std::to_string(vdb.dense_leaves) + " leaves, " +
+                     std::to_string(vdb.dense_active_voxels) + " active voxels";
+        d.rows.push_back(dense);
+        Row ls;
+        ls.method = "OpenVDB level set";
+        ls.prep_seconds = vdb.to_float_seconds + vdb.levelset_seconds;
+        ls.render_seconds = vdb.render_seconds;
+        ls.ttfi_seconds = vdb.time_to_first_image();
+        ls.bytes = vdb.levelset_bytes;
+        ls.error = compare_frames(vdb.frame, reference, voxel);
+        ls.note = "g = s*(iso - f), s = " + fmt(vdb.scale, 5) + ", background " + fmt(vdb.background, 4) +
+                  "; prep = to float + max cell range + shift/scale + copyFromDense";
+        d.rows.push_back(ls);
+    } else {
+        d.notes.push_back("OpenVDB rows skipped: " + vdb.skipped);
+    }
+    {
+        Row raw;
+        raw.method = "raw array (for scale)";
+        raw.bytes = volume.bytes();
+        d.rows.push_back(raw);
+    }
+
+    // The issue's targets, each as a ratio where higher is better.
+    if (!meshes.empty()) {
+        double best_render = INFINITY, best_ttfi = INFINITY;
+        uint64_t least_bytes = UINT64_MAX;
+        for (const auto& m : meshes) {
+            best_render = std::min(best_render, m.render_seconds);
+            best_ttfi = std::min(best_ttfi, m.time_to_first_image());
+            least_bytes = std::min(least_bytes, m.mesh_bytes + m.bvh_bytes);
+        }
+        d.targets.push_back({"octree render speed / Embree mesh render speed", best_render / oct.render_seconds, 0.5,
+                             "fastest Embree render / octiso render"});
+        d.targets.push_back({"time to first image after an isovalue change, mesh / octree", best_ttfi / oct.first_render_seconds,
+                             10.0, "(extract + BVH + first render, best quality) / octiso's first render"});
+        d.targets.push_back({"(mesh + BVH bytes) / octree bytes", double(least_bytes) / double(oct.file_bytes), 3.0,
+                             "smallest mesh + BVH / .oct file bytes"});
+    }
+    if (vdb.ran)
+        d.targets.push_back({"OpenVDB level-set render time / octree render time", vdb.render_seconds / oct.render_seconds, 3.0,
+                             "LevelSetRayIntersector render / octiso render"});
+    return d;
+}
+
+void print_dataset(const DatasetResult& d, bool markdown) {
+    auto s = [](double v) { return std::isnan(v) ? std::string("-") : fmt(v, 3); };
+    Table t({"method", "prep s", "BVH s", "render s", "Mrays/s", "first image s", "MB", "mask mismatch",
+             "depth med/p99/max (vox)", "normal med/max (deg)"});
+    for (const Row& r : d.rows) {
+        const std::string mrays = std::isnan(r.render_seconds) ? "-" : fmt(double(r.error ? r.error->pixels : 0) / r.render_seconds * 1e-6, 2);
+        t.add({r.method, s(r.prep_seconds), s(r.bvh_seconds), s(r.render_seconds), mrays, s(r.ttfi_seconds), mb(r.bytes),
+               r.error ? percent(r.error->mask_mismatch_fraction) : "-", r.error ? depth_cell(*r.error) : "-",
+               r.error ? normal_cell(*r.error) : "-"});
+    }
+    std::cout << "\n### " << d.name << ": " << d.source << " (" << d.type << ", " << d.dims.x << "x" << d.dims.y << "x" << d.dims.z
+              << "), iso " << d.iso << "\n\n";
+    if (markdown) t.print_markdown(std::cout);
+    else t.print(std::cout);
+    std::cout << "\n";
+    for (const Row& r : d.rows)
+        if (!r.note.empty()) std::cout << "- " << r.method << ": " << r.note << "\n";
+    for (const auto& n : d.notes) std::cout << "- " << n << "\n";
+    std::cout << "- reference (exact dense tracer) frame: " << fmt(d.reference_seconds) << " s\n\n";
+    Table targets({"target", "measured", "goal", "met?"});
+    for (const Target& g : d.targets)
+        targets.add({g.name, fmt(g.measured, 2) + "x", ">= " + fmt(g.goal, 1) + "x", g.measured >= g.goal ? "yes" : "NO"});
+    if (markdown) targets.print_markdown(std::cout);
+    else targets.print(std::cout);
+}
+
+/// The 1-minute load average: the machine is shared, and the report should say how busy it was.
+std::string load_average() {
+    std::ifstream in("/proc/loadavg");
+    std::string one;
+    in >> one;
+    return one;
+}
+
+int run_peers(cli::Args& args) {
+    if (args.flag("--help") || args.flag("-h")) {
+        std::cout << kUsage << "\n";
+        return 0;
+    }
+    const bool quick = args.flag("--quick");
+    const std::string datasets_text = args.value("--dataset").value_or("plume,mixing,mri");
+    const uint32_t n = uint32_t(cli::parse_int(args.value("--size").value_or(quick ? "128" : "256"), "--size", 2, 4096));
+    const auto image = cli::parse_size(args.value("--image").value_or(quick ? "256x256" : "512x512"), "--image");
+    const auto iso_text = args.value("--iso");
+    const int repeats = int(cli::parse_int(args.value("--repeats").value_or(quick ? "1" : "3"), "--repeats", 1, 1000));
+    const int threads = int(cli::parse_int(args.value("--threads").value_or("0"), "--threads", 0, 4096));
+    const std::string mri = args.value("--mri").value_or("/usr/share/mricron/templates/ch2.nii.gz");
+    const std::string quality = args.value("--bvh-quality").value_or("both");
+    const std::string normals = args.value("--mesh-normals").value_or("geometric");
+    const bool markdown = args.flag("--markdown"), no_plot = args.flag("--no-plot");
+    const std::string dir = results_dir(args);
+    args.finish();
+
+    std::vector<BvhQuality> qualities;
+    if (quality == "both" || quality == "medium") qualities.push_back(BvhQuality::medium);
+    if (quality == "both" || quality == "high") qualities.push_back(BvhQuality::high);
+    if (qualities.empty()) throw Error("--bvh-quality", "expected both, medium or high, found '" + quality + "'");
+    if (normals != "vertex" && normals != "geometric")
+        throw Error("--mesh-normals", "expected vertex or geometric, found '" + normals + "'");
+    std::vector<std::string> names;
+    {
+        std::stringstream ss(datasets_text);
+        for (std::string item; std::getline(ss, item, ',');)
+            if (!item.empty()) names.push_back(item);
+    }
+    std::optional<tbb::global_control> limit;
+    if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
+
+    std::cout << "octiso-bench peers on " << machine_description() << " (load average " << load_average() << ")\n";
+    std::vector<DatasetResult> results;
+    for (const std::string& name : names) {
+        LoadedVolume volume = open_dataset(name, n, mri);
+        const double iso = iso_text ? cli::parse_double(*iso_text, "--iso") : default_iso(name);
+        const Camera camera = frame_data_box(volume.dims(), volume.placement(), image[0], image[1]);
+        results.push_back(run_dataset(name, volume, iso, camera, repeats, threads, qualities, normals == "vertex"));
+        print_dataset(results.back(), markdown);
+    }
+
+    const std::string json = write_json(dir, "peers", [&](cli::JsonWriter& j) {
+        j.begin_object().field("machine", machine_description()).field("load_average", load_average()).field("width", image[0]).field("height", image[1]);
+        j.field("synthetic_size", n).field("repeats", repeats).field("threads", threads).field("mesh_normals", normals);
+        j.field("openvdb", vdb_available());
+        j.key("datasets").begin_array();
+        for (const DatasetResult& d : results) {
+            j.begin_object().field("name", d.name).field("source", d.source).field("type", d.type);
+            j.key("dims").array(std::vector<uint32_t>{d.dims.x, d.dims.y, d.dims.z});
+            j.field("iso", d.iso).field("raw_bytes", d.raw_bytes).field("reference_seconds", d.reference_seconds);
+            j.key("methods").begin_array();
+            for (const Row& r : d.rows) {
+                j.begin_object().field("method", r.method).field("prep_seconds", r.prep_seconds).field("bvh_seconds", r.bvh_seconds);
+                j.field("render_seconds", r.render_seconds).field("first_image_seconds", r.ttfi_seconds).field("bytes", r.bytes);
+                if (r.error) write_error(j, *r.error);
+                j.field("note", r.note).end_object();
+            }
+            j.end_array();
+            j.key("targets").begin_array();
+            for (const Target& g : d.targets)
+                j.begin_object().field("name", g.name).field("measured", g.measured).field("goal", g.goal).field("how", g.how).end_object();
+            j.end_array();
+            j.key("notes").array(d.notes);
+            j.end_object();
+        }
+        j.end_array().end_object();
+    });
+    std::cerr << "results: " << json << "\n";
+    if (!no_plot) plot("peers", json, dir + "/peers.png");
+    return 0;
+}
+
+}  // namespace
+
+static const bool kRegistered =
+    register_bench("peers", "octiso vs flying edges + Embree BVH and OpenVDB level sets: time, bytes, image error", &run_peers);
+
+}  // namespace octiso::bench

@@ -1,0 +1,294 @@
+// The extract-then-trace peer: vtkFlyingEdges3D (VTK's fastest extractor, TBB backend) -> Embree 3
+// triangle BVH (RTC_SCENE_FLAG_ROBUST, medium or high build quality) -> rtcIntersect1 over the
+// same 16x16 TBB tiles and the same PinholeCamera rays as octiso. Embree's own bytes are counted
+// through its device memory monitor; the mesh buffers are ours and counted exactly.
+#include "bench/peers_mesh.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+#include <vtkAOSDataArrayTemplate.h>
+#include <vtkCellArray.h>
+#include <vtkDataArray.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "bench/bench.h"
+#include "octiso/error.h"
+#include "render/camera.h"
+
+namespace octiso::bench {
+
+std::string bvh_quality_name(BvhQuality q) { return q == BvhQuality::high ? "high" : "medium"; }
+
+namespace {
+
+/// Embree's running allocation total. The monitor may be called concurrently from build threads.
+struct MemoryMonitor {
+    std::atomic<long long> bytes{0};
+};
+
+bool monitor_callback(void* user, ssize_t bytes, bool /*post*/) {
+    static_cast<MemoryMonitor*>(user)->bytes += bytes;   // never cancels, so pre-calls are final
+    return true;
+}
+
+/// The volume as VTK image data: origin and spacing from the placement (CONVENTIONS 1), so the
+/// flying-edges vertices come out in world space. The voxels are shared, not copied, unless they
+/// need a byte swap.
+template <typename T>
+vtkSmartPointer<vtkImageData> image_of(const LoadedVolume& volume, std::vector<T>& swapped) {
+    const VolumeView<T> view = volume.view<T>();
+    const Dims d = volume.dims();
+    const T* voxels = reinterpret_cast<const T*>(view.data);
+    if (view.swap_bytes || reinterpret_cast<uintptr_t>(view.data) % alignof(T) != 0) {
+        swapped.resize(d.voxels());
+        for (uint64_t i = 0; i < d.voxels(); ++i) swapped[i] = view.load(i);
+        voxels = swapped.data();
+    }
+    auto image = vtkSmartPointer<vtkImageData>::New();
+    image->SetDimensions(int(d.x), int(d.y), int(d.z));
+    const Placement& p = volume.placement();
+    image->SetSpacing(p.spacing[0], p.spacing[1], p.spacing[2]);
+    image->SetOrigin(p.origin[0], p.origin[1], p.origin[2]);
+    auto array = vtkSmartPointer<vtkAOSDataArrayTemplate<T>>::New();
+    array->SetNumberOfComponents(1);
+    // save = 1: VTK must not free our buffer. Flying edges only reads it, so the const_cast is safe.
+    array->SetArray(const_cast<T*>(voxels), vtkIdType(d.voxels()), 1);
+    array->SetName("scalars");
+    image->GetPointData()->SetScalars(array);
+    return image;
+}
+
+struct Mesh {
+    std::vector<float> positions;   ///< 3 per vertex, plus one float of padding for Embree's 16-byte loads
+    std::vector<uint32_t> indices;  ///< 3 per triangle
+    std::vector<float> normals;     ///< 3 per vertex (vertex_normals only)
+    uint64_t vertices = 0, triangles = 0;
+};
+
+/// Copies what flying edges produced into the buffers the renderer keeps (so VTK's poly data can
+/// go); the copy is counted with the BVH build, the step that consumes it.
+Mesh mesh_of(vtkPolyData* poly, bool vertex_normals) {
+    Mesh m;
+    m.vertices = uint64_t(poly->GetNumberOfPoints());
+    m.positions.resize(3 * m.vertices + 1, 0.0f);
+    if (m.vertices > 0) {
+        vtkDataArray* points = poly->GetPoints()->GetData();
+        if (auto* f = vtkAOSDataArrayTemplate<float>::SafeDownCast(points)) {
+            std::copy(f->GetPointer(0), f->GetPointer(0) + 3 * m.vertices, m.positions.begin());
+        } else {
+            for (uint64_t i = 0; i < m.vertices; ++i) {
+                double p[3];
+                points->GetTuple(vtkIdType(i), p);
+                for (int a = 0; a < 3; ++a) m.positions[3 * i + a] = float(p[a]);
+            }
+        }
+    }
+    if (vertex_normals) {
+        vtkDataArray* n = poly->GetPointData()->GetNormals();
+        if (!n || uint64_t(n->GetNumberOfTuples()) != m.vertices)
+            throw Error("vtkFlyingEdges3D", "produced no vertex normals", ErrorKind::Other);
+        m.normals.resize(3 * m.vertices);
+        for (uint64_t i = 0; i < m.vertices; ++i) {
+            double v[3];
+            n->GetTuple(vtkIdType(i), v);
+            for (int a = 0; a < 3; ++a) m.normals[3 * i + a] = float(v[a]);
+        }
+    }
+    vtkCellArray* polys = poly->GetPolys();
+    m.triangles = uint64_t(polys->GetNumberOfCells());
+    const uint64_t ids = uint64_t(polys->GetNumberOfConnectivityIds());
+    if (ids != 3 * m.triangles)
+        throw Error("vtkFlyingEdges3D", "output is not all triangles (" + std::to_string(ids) + " ids for " +
+                                            std::to_string(m.triangles) + " cells)", ErrorKind::Other);
+    m.indices.resize(ids);
+    if (polys->IsStorage64Bit()) {
+        const auto* c = polys->GetConnectivityArray64()->GetPointer(0);
+        for (uint64_t i = 0; i < ids; ++i) m.indices[i] = uint32_t(c[i]);
+    } else {
+        const auto* c = polys->GetConnectivityArray32()->GetPointer(0);
+        for (uint64_t i = 0; i < ids; ++i) m.indices[i] = uint32_t(c[i]);
+    }
+    return m;
+}
+
+void throw_on_embree_error(RTCDevice device, const char* what) {
+    const RTCError e = rtcGetDeviceError(device);
+    if (e != RTC_ERROR_NONE) throw Error("embree", std::string(what) + " failed (error " + std::to_string(int(e)) + ")", ErrorKind::Other);
+}
+
+}  // namespace
+
+MeshPeerResult run_mesh_peer(const LoadedVolume& volume, double iso, const Camera& camera, const MeshPeerOptions& options) {
+    MeshPeerResult result;
+    // No vtkSMPTools::Initialize here (its 9.1 header does not compile as C++20): VTK's TBB backend
+    // follows the tbb::global_control the caller sets for --threads.
+
+    // 1. Extraction. The image wrapper is set up before the clock starts: it shares the voxels.
+    vtkNew<vtkFlyingEdges3D> flying_edges;
+    Mesh mesh;
+    {
+        auto extract = [&](auto tag) {
+            using T = decltype(tag);
+            std::vector<T> swapped;
+            vtkSmartPointer<vtkImageData> image = image_of<T>(volume, swapped);
+            flying_edges->SetInputData(image);
+            flying_edges->SetValue(0, iso);
+            flying_edges->SetComputeNormals(options.vertex_normals);
+            flying_edges->SetComputeGradients(false);
+            flying_edges->SetComputeScalars(false);
+            const auto t0 = std::chrono::steady_clock::now();
+            flying_edges->Update();
+            result.extract_seconds = seconds_since(t0);
+            flying_edges->SetInputData(nullptr);   // `swapped` dies with this scope
+        };
+        dispatch_scalar_type(volume.type(), extract);
+    }
+
+    // 2. Upload and BVH build.
+    const std::string config = options.threads > 0 ? "threads=" + std::to_string(options.threads) : "";
+    RTCDevice device = rtcNewDevice(config.c_str());
+    if (!device) throw Error("embree", "rtcNewDevice failed", ErrorKind::Other);
+    MemoryMonitor monitor;
+    rtcSetDeviceMemoryMonitorFunction(device, monitor_callback, &monitor);
+    RTCScene scene = nullptr;
+    try {
+        const auto t0 = std::chrono::steady_clock::now();
+        mesh = mesh_of(flying_edges->GetOutput(), options.vertex_normals);
+        flying_edges->GetOutput()->Initialize();   // the renderer keeps only `mesh`
+        scene = rtcNewScene(device);
+        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+        rtcSetSceneBuildQuality(scene, options.quality == BvhQuality::high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+        if (mesh.triangles > 0) {
+            RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+            rtcSetGeometryBuildQuality(geometry, options.quality == BvhQuality::high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+            rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
+                                       3 * sizeof(float), size_t(mesh.vertices));
+            rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
+                                       3 * sizeof(uint32_t), size_t(mesh.triangles));
+            rtcCommitGeometry(geometry);
+            rtcAttachGeometry(scene, geometry);
+            rtcReleaseGeometry(geometry);
+        }
+        rtcCommitScene(scene);
+        result.bvh_seconds = seconds_since(t0);
+        throw_on_embree_error(device, "building the triangle BVH");
+    } catch (...) {
+        if (scene) rtcReleaseScene(scene);
+        rtcReleaseDevice(device);
+        throw;
+    }
+    result.vertices = mesh.vertices;
+    result.triangles = mesh.triangles;
+    result.mesh_bytes = (mesh.positions.size() + mesh.normals.size()) * sizeof(float) + mesh.indices.size() * sizeof(uint32_t);
+    result.bvh_bytes = uint64_t(std::max(0LL, monitor.bytes.load()));
+
+    // 3. Rendering: the same rays, tiles and partitioner as octiso's render().
+    const PinholeCamera pinhole(camera);
+    const int W = camera.width, H = camera.height;
+    auto render_once = [&](Frame& frame, Frame* geometric) {
+        frame.width = W, frame.height = H;
+        frame.depth.assign(size_t(W) * H, 0.0f);
+        frame.normal.assign(size_t(W) * H * 3, 0.0f);
+        if (geometric) {
+            geometric->width = W, geometric->height = H;
+            geometric->normal.assign(size_t(W) * H * 3, 0.0f);
+        }
+        std::atomic<uint64_t> hits{0};
+        const auto t0 = std::chrono::steady_clock::now();
+        tbb::parallel_for(
+            tbb::blocked_range2d<int>(0, H, 16, 0, W, 16),
+            [&](const tbb::blocked_range2d<int>& tile) {
+                RTCIntersectContext context;
+                rtcInitIntersectContext(&context);
+                uint64_t tile_hits = 0;
+                for (int py = tile.rows().begin(); py < tile.rows().end(); ++py)
+                    for (int px = tile.cols().begin(); px < tile.cols().end(); ++px) {
+                        const Ray ray = pinhole.ray(px, py);
+                        RTCRayHit rh;
+                        rh.ray.org_x = float(ray.origin[0]), rh.ray.org_y = float(ray.origin[1]), rh.ray.org_z = float(ray.origin[2]);
+                        rh.ray.dir_x = float(ray.dir[0]), rh.ray.dir_y = float(ray.dir[1]), rh.ray.dir_z = float(ray.dir[2]);
+                        rh.ray.tnear = 0.0f;
+                        rh.ray.tfar = std::numeric_limits<float>::infinity();
+                        rh.ray.time = 0.0f;
+                        rh.ray.mask = ~0u;   // Debian's Embree is built with ray masks: 0 would hit nothing
+                        rh.ray.id = 0;
+                        rh.ray.flags = 0;
+                        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                        rtcIntersect1(scene, &context, &rh);
+                        const size_t i = size_t(py) * W + px;
+                        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+                            frame.depth[i] = std::numeric_limits<float>::infinity();
+                            continue;
+                        }
+                        ++tile_hits;
+                        frame.depth[i] = rh.ray.tfar;
+                        float ng[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+                        float n[3] = {ng[0], ng[1], ng[2]};
+                        if (options.vertex_normals) {
+                            const uint32_t* tri = &mesh.indices[3 * size_t(rh.hit.primID)];
+                            const float w0 = 1.0f - rh.hit.u - rh.hit.v;
+                            for (int a = 0; a < 3; ++a)
+                                n[a] = w0 * mesh.normals[3 * tri[0] + a] + rh.hit.u * mesh.normals[3 * tri[1] + a] +
+                                       rh.hit.v * mesh.normals[3 * tri[2] + a];
+                        }
+                        // Unit length and facing the ray, as CONVENTIONS 2 asks of every normal AOV.
+                        auto store = [&](const float* v, std::vector<float>& out) {
+                            const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                            if (!(len > 0)) {
+                                for (int a = 0; a < 3; ++a) out[3 * i + a] = -float(ray.dir[a]);
+                                return;
+                            }
+                            const float facing = v[0] * float(ray.dir[0]) + v[1] * float(ray.dir[1]) + v[2] * float(ray.dir[2]) > 0 ? -1.0f : 1.0f;
+                            for (int a = 0; a < 3; ++a) out[3 * i + a] = facing * v[a] / len;
+                        };
+                        store(n, frame.normal);
+                        if (geometric) store(ng, geometric->normal);
+                    }
+                hits += tile_hits;
+            },
+            tbb::simple_partitioner());
+        frame.stats.seconds = seconds_since(t0);
+        frame.stats.rays = uint64_t(W) * H;
+        frame.stats.hits = hits;
+        if (geometric) geometric->depth = frame.depth;
+    };
+
+    try {
+        const auto t0 = std::chrono::steady_clock::now();
+        render_once(result.frame, &result.frame_geometric);
+        result.first_render_seconds = seconds_since(t0);
+        std::vector<double> seconds;
+        Frame scratch;
+        for (int r = 0; r < std::max(options.repeats, 1); ++r) {
+            render_once(scratch, nullptr);
+            seconds.push_back(scratch.stats.seconds);
+        }
+        std::sort(seconds.begin(), seconds.end());
+        result.render_seconds = seconds[seconds.size() / 2];
+        result.frame.stats.seconds = result.render_seconds;
+    } catch (...) {
+        rtcReleaseScene(scene);
+        rtcReleaseDevice(device);
+        throw;
+    }
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+    return result;
+}
+
+}  // namespace octiso::bench
