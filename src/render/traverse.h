@@ -11,12 +11,17 @@
 // corners equal to the leaf value, so unless an isovalue equals it only the shell of cells at its
 // +x/+y/+z faces (whose forward corners lie in neighbours) is walked.
 // Corners: inside a cap, a forward neighbour in the same cap is a direct read (octant & dir == 0),
-// otherwise neighbour finding climbs the parent trace this traversal keeps (App. B.2).
+// otherwise neighbour finding climbs the parent trace this traversal keeps (App. B.2); each of the
+// 7 forward neighbour blocks of a cap is located once per cap visit and then read directly
+// (measured by `octiso-bench grid`: +3-5 % frames/s on octree data, docs/bench/grid.md).
+// The corner source is a policy only for the grid benchmark's "octree over array data" variant
+// (Knoll 2006 Table 3); with the default, OctreeCornerSource, the policy costs nothing.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "octiso/octree.h"
 #include "octiso/render.h"
@@ -33,11 +38,18 @@ struct TraceHit {
     bool is_hit() const { return iso_index >= 0; }
 };
 
-template <typename T, class Finder> class OctreeTracer {
+/// The default corner source: the octree itself (in-cap reads and neighbour finding). Any other
+/// Corners type provides `void gather(Coord cell, double corner[8]) const` and replaces every
+/// corner read (e.g. ArrayCorners<T> in src/reference/macrocell.h); the octree then only culls.
+struct OctreeCornerSource {};
+
+template <typename T, class Finder, class Corners = OctreeCornerSource> class OctreeTracer {
+    static constexpr bool kOwnCorners = std::is_same_v<Corners, OctreeCornerSource>;
+
 public:
     OctreeTracer(const Octree<T>& tree, const Placement& placement, const double* isovalues, int iso_count,
-                 const Finder& finder)
-        : tree_(tree), placement_(placement), iso_count_(iso_count), finder_(finder) {
+                 const Finder& finder, const Corners& corners = Corners{})
+        : tree_(tree), placement_(placement), iso_count_(iso_count), finder_(finder), corners_(corners) {
         for (int i = 0; i < iso_count; ++i) iso_[i] = isovalues[i];
         const Dims d = tree.dims();
         box_hi_ = {double(d.x) - 1, double(d.y) - 1, double(d.z) - 1};
@@ -76,15 +88,20 @@ private:
     }
 
     /// Whether the ray is on the upper side of the plane p[a] == plane at time t (the side it
-    /// occupies on [t, t + dt) for small dt): decided from times, never from positions.
-    static bool upper_at(const IndexRay& r, int a, double plane, double t_plane, double t) {
+    /// occupies on [t, t + dt) for small dt): decided from times, never from positions. A ray lying
+    /// in the plane takes the upper side, except in the data box's top face (plane == box_hi),
+    /// whose only cells lie below it (the box is closed, CONVENTIONS 2b).
+    bool upper_at(const IndexRay& r, int a, double plane, double t_plane, double t) const {
         const double d = r.dir[a];
         if (d > 0) return t_plane <= t;
         if (d < 0) return t < t_plane;
-        return r.origin[a] >= plane;
+        return r.origin[a] > plane || (r.origin[a] == plane && plane < box_hi_[a]);
     }
 
-    bool node(Walk& w, int d, uint32_t index, Coord o, double t0, double t1) const {
+    // Node origins travel by reference: a Coord passed by value is assembled with 32-bit stores
+    // and reloaded as a 64-bit register pair, a store-forwarding stall that cost 18 % of node()
+    // (perf annotate, plume 256^3 at 1024^2).
+    bool node(Walk& w, int d, uint32_t index, const Coord& o, double t0, double t1) const {
         w.trace[d] = index;
         const InteriorNode<T>& n = tree_.node(d, index);
         const uint32_t half = tree_.child_bit(d);
@@ -122,26 +139,56 @@ private:
         return false;
     }
 
-    bool cap(Walk& w, uint32_t cap_index, Coord co, double t0, double t1) const {
+    /// Octree<T>::neighbour_find, returning where the descent ended instead of only the value.
+    LeafRef<T> locate_neighbour(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
+        for (int d = depth; d > 0; --d) {
+            const int shift = tree_.dmax() - d;
+            if (((start.x ^ dest.x) >> shift) == 0 && ((start.y ^ dest.y) >> shift) == 0 &&
+                ((start.z ^ dest.z) >> shift) == 0)
+                return tree_.locate_from(dest, d, parent_trace[d]);
+        }
+        return tree_.locate_from(dest, 0, 0);
+    }
+
+    bool cap(Walk& w, uint32_t cap_index, const Coord& co, double t0, double t1) const {
         w.trace[tree_.dmax() - 1] = cap_index;
         const Cap<T>& cap = tree_.cap(cap_index);
+        // The forward neighbour blocks (2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), r = 1..7) are each a
+        // cap or lie inside one scalar leaf: located once per cap visit by neighbour finding, on
+        // first use, and then read directly for every corner and cell that falls in them.
+        LeafRef<T> block[8];
+        unsigned located = 0;
         return walk_cells(w, co, 2, t0, t1, [&](Coord v, double corner[8]) {
+            if constexpr (!kOwnCorners) {
+                corners_.gather(v, corner);
+                return;
+            }
             const int oct = int(((v.x - co.x) << 2) | ((v.y - co.y) << 1) | (v.z - co.z));
             for (int k = 0; k < 8; ++k) {
                 const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
-                if ((oct & dir) == 0) {
+                const int r = oct & dir;                                         // which block holds the corner
+                if (r == 0) {
                     corner[k] = double(cap.voxel[oct | dir]);
-                } else {
-                    const Coord dest{v.x + (k & 1), v.y + ((k >> 1) & 1), v.z + ((k >> 2) & 1)};
-                    corner[k] = double(tree_.neighbour_find(v, dest, tree_.dmax() - 1, w.trace));
+                    continue;
                 }
+                if (!((located >> r) & 1u)) {
+                    const Coord b{co.x + ((r & 4) ? 2u : 0u), co.y + ((r & 2) ? 2u : 0u), co.z + ((r & 1) ? 2u : 0u)};
+                    block[r] = locate_neighbour(co, b, tree_.dmax() - 1, w.trace);
+                    located |= 1u << r;
+                }
+                corner[k] = block[r].in_cap ? double(tree_.cap(block[r].index).voxel[(oct | dir) & ~r])
+                                            : double(block[r].value);
             }
         });
     }
 
-    bool scalar_leaf(Walk& w, int holder_depth, Coord co, uint32_t side, T value, double t0, double t1) const {
+    bool scalar_leaf(Walk& w, int holder_depth, const Coord& co, uint32_t side, T value, double t0, double t1) const {
         const double v = double(value);
         auto gather = [&](Coord p, double corner[8]) {
+            if constexpr (!kOwnCorners) {
+                corners_.gather(p, corner);
+                return;
+            }
             const uint32_t ex = co.x + side, ey = co.y + side, ez = co.z + side;
             for (int k = 0; k < 8; ++k) {
                 const Coord dest{p.x + (k & 1), p.y + ((k >> 1) & 1), p.z + ((k >> 2) & 1)};
@@ -177,7 +224,7 @@ private:
     /// Each data cell gets the half-open piece [t_in, t_out) (closed at the data exit); `gather`
     /// fills its 8 corners. Returns true at the first hit.
     template <class Gather>
-    bool walk_cells(Walk& w, Coord lo, uint32_t side, double t0, double t1, Gather&& gather) const {
+    bool walk_cells(Walk& w, const Coord& lo, uint32_t side, double t0, double t1, Gather&& gather) const {
         const IndexRay& r = w.ray;
         const uint32_t box_lo[3] = {lo.x, lo.y, lo.z};
         const Dims dims = tree_.dims();
@@ -186,6 +233,7 @@ private:
         for (int a = 0; a < 3; ++a) {
             const double p = r.origin[a] + t0 * r.dir[a];
             int64_t i = int64_t(std::floor(p));
+            if (r.dir[a] == 0 && p == box_hi_[a]) i = int64_t(last_cell[a]);   // lying in the top face
             const int64_t b0 = box_lo[a], b1 = int64_t(box_lo[a]) + side - 1;
             i = std::clamp(i, b0, b1);
             // Settle rounding of p at a cell face with the same plane times the DDA steps on.
@@ -269,6 +317,7 @@ private:
     double iso_[kMaxIsovalues] = {};
     int iso_count_;
     const Finder finder_;
+    [[no_unique_address]] const Corners corners_;
     std::array<double, 3> box_hi_{};
     bool has_cells_ = false;
 };
