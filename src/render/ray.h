@@ -38,9 +38,15 @@ struct IndexRay {
         r.set_direction(d);
         return r;
     }
+    /// A component whose reciprocal overflows (|d| < 2^-1024, subnormal) is flushed to +0: such a
+    /// ray needs t > 1e300 to cross one cell, so it is parallel to that axis for every purpose, and
+    /// flushing keeps 0 * inf (a NaN) out of plane_t.
     void set_direction(const std::array<double, 3>& d) {
         dir = d;
-        for (int a = 0; a < 3; ++a) inv_dir[a] = d[a] == 0 ? 0.0 : 1.0 / d[a];
+        for (int a = 0; a < 3; ++a) {
+            inv_dir[a] = d[a] == 0 ? 0.0 : 1.0 / d[a];
+            if (!std::isfinite(inv_dir[a])) dir[a] = 0.0, inv_dir[a] = 0.0;
+        }
     }
 };
 

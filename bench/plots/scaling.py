@@ -1,0 +1,44 @@
+"""Scaling plot: left, measured parallel efficiency per thread count and image size; right, the
+simulated speedup of the dynamic tile schedule (and a static split) from measured tile costs."""
+import matplotlib.pyplot as plt
+
+
+def plot(data, out_png):
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.5))
+    widths = sorted({m["width"] for m in data["measured"]})
+    for w in widths:
+        rows = sorted((m for m in data["measured"] if m["width"] == w), key=lambda m: m["threads"])
+        one = next(m["median_seconds"] for m in rows if m["threads"] == 1)
+        p = [m["threads"] for m in rows]
+        eff = [100.0 * one / m["median_seconds"] / m["threads"] for m in rows]
+        left.plot(p, eff, "o-", label=f"{w}^2 wall")
+        if all(m.get("cpu_seconds") for m in rows):
+            med = lambda v: sorted(v)[len(v) // 2]
+            one_cpu = med(next(m["cpu_seconds"] for m in rows if m["threads"] == 1))
+            left.plot(p, [100.0 * one_cpu / med(m["cpu_seconds"]) for m in rows], "s--",
+                      label=f"{w}^2 CPU work (1 thread / P threads)")
+    left.axhline(95, color="grey", ls="--", lw=0.8, label="target 95 %")
+    left.set_xlabel("threads")
+    left.set_ylabel("parallel efficiency, %")
+    left.set_ylim(0, 110)
+    left.set_title("measured (render(), Embree, colour)")
+    left.legend(fontsize=8)
+    left.grid(alpha=0.3)
+    for s in data["simulated"]:
+        right.plot(s["workers"], s["dynamic_speedup"], "o-", label=f"dynamic {s['width']}^2, {s.get('tile', 16)}^2 tiles")
+        if s.get("tile", 16) == 16:
+            right.plot(s["workers"], s["static_speedup"], "x:", label=f"static {s['width']}^2, {s.get('tile', 16)}^2 tiles")
+    top = max(max(s["workers"]) for s in data["simulated"])
+    right.plot([1, top], [1, top], color="grey", lw=0.8, label="ideal")
+    right.plot([1, top], [0.9, 0.9 * top], color="grey", ls="--", lw=0.8, label="90 % efficiency")
+    right.set_xscale("log", base=2)
+    right.set_yscale("log", base=2)
+    right.set_xlabel("workers")
+    right.set_ylabel("speedup (sum of tile costs / makespan)")
+    right.set_title("simulated schedule of measured tile costs")
+    right.legend(fontsize=7)
+    right.grid(alpha=0.3)
+    fig.suptitle(f"{data['dataset']} {'x'.join(map(str, data['dims']))}, iso {data['iso']}; "
+                 f"load average {data.get('loadavg', '?').split(' ')[0]} on this machine", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out_png, dpi=120)

@@ -1,0 +1,322 @@
+// octiso-bench scaling (issue 5, item 3; the paper's Fig. 9): frames/s of render() (Embree, shading)
+// on 1..nproc threads at 512^2 and 1024^2, and the load-balance bound of the dynamic tile scheduler
+// on 1..64 workers: 8x8 blocks timed single-threaded, summed into tiles, list-scheduled in TBB's
+// split order (each worker takes the next tile when free: work stealing without overhead); speedup
+// = sum / makespan. A static split into P equal runs of tiles is shown for contrast.
+#include <time.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iostream>
+#include <queue>
+#include <sstream>
+#include <thread>
+
+#include "bench/bench.h"
+#include "octiso/build.h"
+#include "octiso/error.h"
+#include "octiso/reader.h"
+#include "octiso/render.h"
+#include "octiso/synthetic.h"
+#include "render/camera.h"
+#include "render/traverse.h"
+
+namespace octiso::bench {
+namespace {
+
+const char* const kScalingUsage =
+    "usage: octiso-bench scaling [--dataset NAME] [--size N] [--images 512,1024] [--iso V] [--repeats N]\n"
+    "                            [--max-threads N] [--mri FILE] [--quick]\n"
+    "  NAME: plume (default), mixing (synthetic N^3, default 256) or mri\n"
+    "  --quick: 128^3, images 256 and 512, 2 repeats";
+
+double scaling_default_iso(const std::string& dataset) {   // same as `octiso-bench peers`
+    if (dataset == "plume") return 40.5;
+    if (dataset == "mixing") return 127.5;
+    return 80.5;
+}
+
+/// Tiles of blocked_range2d(0, H, ts, 0, W, ts) in the order TBB's simple_partitioner produces them
+/// when run serially: split the side that is longer relative to its grain size, at the middle,
+/// left half first (oneTBB blocked_range2d::do_split), until neither side exceeds the grain.
+struct Tile {
+    int y0, y1, x0, x1;
+};
+void tbb_tile_order(int y0, int y1, int x0, int x1, int ts, std::vector<Tile>& out) {
+    const bool rows_divisible = y1 - y0 > ts, cols_divisible = x1 - x0 > ts;
+    if (!rows_divisible && !cols_divisible) {
+        out.push_back({y0, y1, x0, x1});
+        return;
+    }
+    const bool split_cols = (y1 - y0) < (x1 - x0);   // equal grains: the longer side, ties to rows
+    if (split_cols) {
+        const int m = x0 + (x1 - x0) / 2;
+        tbb_tile_order(y0, y1, x0, m, ts, out);
+        tbb_tile_order(y0, y1, m, x1, ts, out);
+    } else {
+        const int m = y0 + (y1 - y0) / 2;
+        tbb_tile_order(y0, m, x0, x1, ts, out);
+        tbb_tile_order(m, y1, x0, x1, ts, out);
+    }
+}
+
+/// Makespan of greedy list scheduling: tiles in order, each to the worker that is free first.
+double list_schedule_makespan(const std::vector<double>& cost, int workers) {
+    std::priority_queue<double, std::vector<double>, std::greater<double>> free_at;
+    for (int i = 0; i < workers; ++i) free_at.push(0.0);
+    double makespan = 0;
+    for (double c : cost) {
+        const double start = free_at.top();
+        free_at.pop();
+        free_at.push(start + c);
+        makespan = std::max(makespan, start + c);
+    }
+    return makespan;
+}
+
+/// Makespan of a static split: P contiguous runs of (nearly) equal tile count.
+double static_makespan(const std::vector<double>& cost, int workers) {
+    double makespan = 0;
+    const size_t n = cost.size();
+    for (int w = 0; w < workers; ++w) {
+        double sum = 0;
+        for (size_t i = n * size_t(w) / size_t(workers); i < n * size_t(w + 1) / size_t(workers); ++i) sum += cost[i];
+        makespan = std::max(makespan, sum);
+    }
+    return makespan;
+}
+
+/// CPU seconds of the whole process (all threads, spinning workers included).
+double process_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+struct Measured {
+    int width = 0, threads = 0;
+    std::vector<double> seconds;       // wall seconds of the tile loop (RenderStats)
+    std::vector<double> cpu_seconds;   // process CPU seconds of the whole render() call
+    std::vector<double> call_seconds;  // wall seconds of the whole render() call (setup included)
+    static double median_of(std::vector<double> s) {
+        std::sort(s.begin(), s.end());
+        return s.empty() ? 0 : s[s.size() / 2];
+    }
+    double median() const {
+        std::vector<double> s = seconds;
+        std::sort(s.begin(), s.end());
+        return s[s.size() / 2];
+    }
+};
+
+struct Simulated {
+    int width = 0, tile = 16;
+    uint64_t tiles = 0;
+    double sum_seconds = 0, max_tile_seconds = 0;
+    std::vector<int> workers;
+    std::vector<double> dynamic_speedup, static_speedup;
+};
+
+/// Seconds of each 8x8 block of the frame (row-major, ceil(W/8) per row), single-threaded on the
+/// direct path; the minimum of `passes` timings per block, so an interruption by another process
+/// does not count as cost. Tiles of 16 (or 8) are sums of their blocks.
+template <typename T>
+std::vector<double> block_costs(const Octree<T>& tree, const Placement& placement, const Camera& camera, double iso,
+                                int passes) {
+    const OctreeTracer<T, Neubauer> tracer(tree, placement, &iso, 1, Neubauer{});
+    const PinholeCamera pinhole(camera);
+    const int bw = (camera.width + 7) / 8, bh = (camera.height + 7) / 8;
+    std::vector<double> cost(size_t(bw) * bh, 1e300);
+    uint64_t sink = 0;
+    for (int p = 0; p < passes; ++p)
+        for (int by = 0; by < bh; ++by)
+            for (int bx = 0; bx < bw; ++bx) {
+                const auto t0 = std::chrono::steady_clock::now();
+                for (int py = by * 8; py < std::min(by * 8 + 8, camera.height); ++py)
+                    for (int px = bx * 8; px < std::min(bx * 8 + 8, camera.width); ++px)
+                        sink += tracer.trace(pinhole.ray(px, py), true).is_hit();
+                double& c = cost[size_t(by) * bw + bx];
+                c = std::min(c, seconds_since(t0));
+            }
+    if (sink == uint64_t(-1)) std::cerr << "";   // keep the traces observable
+    return cost;
+}
+
+/// Costs of the tiles of side `ts` in TBB order: the sum of the 8x8 blocks whose corner lies in them.
+std::vector<double> tile_costs(const std::vector<double>& blocks, int width, int height, int ts) {
+    std::vector<Tile> tiles;
+    tbb_tile_order(0, height, 0, width, ts, tiles);
+    const int bw = (width + 7) / 8;
+    std::vector<double> cost;
+    for (const Tile& t : tiles) {
+        double c = 0;
+        for (int by = (t.y0 + 7) / 8; by * 8 < t.y1; ++by)
+            for (int bx = (t.x0 + 7) / 8; bx * 8 < t.x1; ++bx) c += blocks[size_t(by) * bw + bx];
+        cost.push_back(c);
+    }
+    return cost;
+}
+
+int run_scaling(cli::Args& args) {
+    if (args.flag("--help")) {
+        std::cout << kScalingUsage << "\n";
+        return 0;
+    }
+    const bool quick = args.flag("--quick");
+    const auto ds = args.value("--dataset");
+    const auto size_flag = args.value("--size");
+    const auto images_flag = args.value("--images");
+    const auto iso_flag = args.value("--iso");
+    const auto repeats_flag = args.value("--repeats");
+    const auto max_threads_flag = args.value("--max-threads");
+    const auto mri_flag = args.value("--mri");
+    const std::string results = results_dir(args);
+    args.finish();
+
+    const std::string name = ds ? *ds : "plume";
+    const uint32_t n = size_flag ? uint32_t(cli::parse_int(*size_flag, "--size", 8, 2048)) : quick ? 128 : 256;
+    std::vector<int> widths = quick ? std::vector<int>{256, 512} : std::vector<int>{512, 1024};
+    if (images_flag) {
+        widths.clear();
+        for (double w : cli::parse_list(*images_flag, "--images")) {
+            if (!(w >= 16 && w <= 16384 && w == std::floor(w))) throw Error("--images", "expected square sizes 16 .. 16384");
+            widths.push_back(int(w));
+        }
+    }
+    const int repeats = repeats_flag ? int(cli::parse_int(*repeats_flag, "--repeats", 1, 1000)) : quick ? 2 : 3;
+    const int hw = int(std::max(1u, std::thread::hardware_concurrency()));
+    const int max_threads = max_threads_flag ? int(cli::parse_int(*max_threads_flag, "--max-threads", 1, 1024)) : hw;
+    LoadedVolume volume;
+    if (name == "plume" || name == "mixing") volume = synthetic_step(name, Dims{n, n, n}, 0);
+    else if (name == "mri") volume = open_volume(mri_flag ? *mri_flag : "/usr/share/mricron/templates/ch2.nii.gz", RawOptions{});
+    else throw Error("--dataset", "expected plume, mixing or mri, found '" + name + "'");
+    const double iso = iso_flag ? cli::parse_double(*iso_flag, "--iso") : scaling_default_iso(name);
+    const Dims dims = volume.dims();
+    std::cerr << "scaling: " << name << " " << dims.x << "x" << dims.y << "x" << dims.z << ", iso " << iso << "\n";
+
+    std::vector<Measured> measured;
+    std::vector<Simulated> simulated;
+    const std::vector<int> sim_workers = {1, 2, 4, 8, 16, 32, 64};
+    dispatch_scalar_type(volume.type(), [&](auto tag) {
+        using T = decltype(tag);
+        const OctreeData<T> data = build_octree(volume.view<T>(), BuildOptions{});
+        const Octree<T> tree = data.view();
+        for (int w : widths) {
+            const Camera camera = frame_data_box(dims, volume.placement(), w, w);
+            RenderOptions options;
+            options.isovalues = {iso};
+            std::vector<Measured> rows;
+            for (int p = 1; p <= max_threads; ++p) {
+                Measured m;
+                m.width = w, m.threads = p;
+                rows.push_back(m);
+            }
+            for (auto& r : rows) {   // warm-up
+                options.threads = r.threads;
+                render(tree, volume.placement(), camera, options);
+            }
+            for (int k = 0; k < repeats; ++k)
+                for (size_t i = 0; i < rows.size(); ++i) {
+                    auto& r = rows[k % 2 ? rows.size() - 1 - i : i];   // alternate the order per round
+                    options.threads = r.threads;
+                    const double c0 = process_cpu_seconds();
+                    const auto w0 = std::chrono::steady_clock::now();
+                    r.seconds.push_back(render(tree, volume.placement(), camera, options).stats.seconds);
+                    r.call_seconds.push_back(seconds_since(w0));
+                    r.cpu_seconds.push_back(process_cpu_seconds() - c0);
+                }
+            for (auto& r : rows) measured.push_back(r);
+
+            const std::vector<double> blocks = block_costs(tree, volume.placement(), camera, iso, quick ? 1 : 3);
+            for (int ts : {16, 8}) {   // 16: the renderer's tiles; 8: what finer tiles would give
+                Simulated s;
+                s.width = w;
+                s.tile = ts;
+                const std::vector<double> cost = tile_costs(blocks, w, w, ts);
+                s.tiles = cost.size();
+                for (double c : cost) s.sum_seconds += c, s.max_tile_seconds = std::max(s.max_tile_seconds, c);
+                for (int p : sim_workers) {
+                    s.workers.push_back(p);
+                    s.dynamic_speedup.push_back(s.sum_seconds / list_schedule_makespan(cost, p));
+                    s.static_speedup.push_back(s.sum_seconds / static_makespan(cost, p));
+                }
+                simulated.push_back(s);
+            }
+        }
+    });
+
+    std::string load;   // other processes on the machine distort the measured (not the simulated) rows
+    {
+        std::ifstream f("/proc/loadavg");
+        std::getline(f, load);
+    }
+    std::cout << "machine: " << machine_description() << "; load average at the end: " << load << "\n";
+    Table mt({"image", "threads", "frames/s", "Mrays/s", "speedup", "efficiency", "CPU s/frame", "CPU-work eff.",
+              "render() setup s"});
+    for (const auto& m : measured) {
+        double one = 0, one_cpu = 0;
+        for (const auto& o : measured)
+            if (o.width == m.width && o.threads == 1) one = o.median(), one_cpu = Measured::median_of(o.cpu_seconds);
+        const double speedup = one / m.median();
+        const double cpu = Measured::median_of(m.cpu_seconds);
+        mt.add({std::to_string(m.width) + "^2", std::to_string(m.threads), fmt(1.0 / m.median(), 2),
+                fmt(double(m.width) * m.width / m.median() * 1e-6, 2), fmt(speedup, 3), fmt(100.0 * speedup / m.threads, 1) + " %",
+                fmt(cpu, 3), fmt(100.0 * one_cpu / cpu, 1) + " %",
+                fmt(Measured::median_of(m.call_seconds) - m.median(), 4)});
+    }
+    std::cout << "measured (render(), Embree path, colour, median of " << repeats << " interleaved repeats); "
+                 "CPU-work eff. = process CPU of 1 thread / process CPU of P threads (not distorted by other "
+                 "processes, but blind to idle waiting)\n";
+    mt.print(std::cout);
+    std::cout << "\n";
+    mt.print_markdown(std::cout);
+    Table st({"image", "tile", "tiles", "max tile / mean", "P", "dynamic speedup", "dynamic eff.", "static speedup", "static eff."});
+    for (const auto& s : simulated)
+        for (size_t i = 0; i < s.workers.size(); ++i)
+            st.add({std::to_string(s.width) + "^2", std::to_string(s.tile), std::to_string(s.tiles),
+                    fmt(s.max_tile_seconds / (s.sum_seconds / double(s.tiles)), 2), std::to_string(s.workers[i]),
+                    fmt(s.dynamic_speedup[i], 2), fmt(100.0 * s.dynamic_speedup[i] / s.workers[i], 1) + " %",
+                    fmt(s.static_speedup[i], 2), fmt(100.0 * s.static_speedup[i] / s.workers[i], 1) + " %"});
+    std::cout << "\nsimulated schedule of measured tile costs (load-balance bound, no scheduling overhead)\n";
+    st.print(std::cout);
+    std::cout << "\n";
+    st.print_markdown(std::cout);
+
+    const std::string json = write_json(results, "scaling", [&](cli::JsonWriter& j) {
+        j.begin_object();
+        j.field("machine", machine_description()).field("dataset", name).field("source", volume.source());
+        j.key("dims").array(std::vector<uint32_t>{dims.x, dims.y, dims.z});
+        j.field("iso", iso).field("repeats", repeats).field("loadavg", load);
+        j.key("measured").begin_array();
+        for (const auto& m : measured) {
+            j.begin_object();
+            j.field("width", m.width).field("threads", m.threads).field("median_seconds", m.median());
+            j.key("seconds").array(m.seconds);
+            j.key("cpu_seconds").array(m.cpu_seconds);
+            j.key("call_seconds").array(m.call_seconds);
+            j.end_object();
+        }
+        j.end_array();
+        j.key("simulated").begin_array();
+        for (const auto& s : simulated) {
+            j.begin_object();
+            j.field("width", s.width).field("tile", s.tile).field("tiles", s.tiles).field("sum_seconds", s.sum_seconds);
+            j.field("max_tile_seconds", s.max_tile_seconds);
+            j.key("workers").array(s.workers);
+            j.key("dynamic_speedup").array(s.dynamic_speedup);
+            j.key("static_speedup").array(s.static_speedup);
+            j.end_object();
+        }
+        j.end_array();
+        j.end_object();
+    });
+    std::cerr << "results: " << json << "\n";
+    plot("scaling", json, results + "/scaling.png");
+    return 0;
+}
+
+static const bool kRegistered =
+    register_bench("scaling", "frames/s on 1..nproc threads, and the simulated tile schedule on 1..64", &run_scaling);
+
+}  // namespace
+}  // namespace octiso::bench
