@@ -14,9 +14,9 @@ namespace octiso {
 
 struct ExactRayContext {
     RTCIntersectContext base;   // must come first: Embree hands the callback a pointer to it
-    const Ray* ray;
+    const Ray* rays;            // lane i of the packet (or the single ray) traces rays[i]
     bool want_normal;
-    TraceHit hit;
+    TraceHit hits[EmbreeVolumeScene::kPacket];
 };
 
 namespace {
@@ -44,30 +44,36 @@ void bounds_callback(const RTCBoundsFunctionArguments* args) {
 }
 
 void intersect_callback(const RTCIntersectFunctionNArguments* args) noexcept {
-    if (args->N != 1 || !args->valid[0]) return;
     auto* ctx = reinterpret_cast<ExactRayContext*>(args->context);
     const auto* g = static_cast<const VolumeGeometry*>(args->geometryUserPtr);
-    RTCRayHit* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
-    const TraceHit hit = g->trace(g->user, *ctx->ray, ctx->want_normal);
-    if (!hit.is_hit() || !(hit.t < ctx->hit.t)) return;
-    ctx->hit = hit;
-    rh->ray.tfar = float(hit.t);
-    rh->hit.Ng_x = float(hit.normal[0]);
-    rh->hit.Ng_y = float(hit.normal[1]);
-    rh->hit.Ng_z = float(hit.normal[2]);
-    rh->hit.u = rh->hit.v = 0;
-    rh->hit.geomID = args->geomID;
-    rh->hit.primID = args->primID;
-    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    const unsigned n = args->N;
+    RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, n);
+    RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, n);
+    for (unsigned i = 0; i < n && i < EmbreeVolumeScene::kPacket; ++i) {
+        if (!args->valid[i]) continue;
+        const TraceHit hit = g->trace(g->user, ctx->rays[i], ctx->want_normal);
+        if (!hit.is_hit() || !(hit.t < ctx->hits[i].t)) continue;
+        ctx->hits[i] = hit;
+        RTCRayN_tfar(rays, n, i) = float(hit.t);
+        RTCHitN_Ng_x(hits, n, i) = float(hit.normal[0]);
+        RTCHitN_Ng_y(hits, n, i) = float(hit.normal[1]);
+        RTCHitN_Ng_z(hits, n, i) = float(hit.normal[2]);
+        RTCHitN_u(hits, n, i) = RTCHitN_v(hits, n, i) = 0;
+        RTCHitN_geomID(hits, n, i) = args->geomID;
+        RTCHitN_primID(hits, n, i) = args->primID;
+        RTCHitN_instID(hits, n, i, 0) = RTC_INVALID_GEOMETRY_ID;
+    }
 }
 
 void occluded_callback(const RTCOccludedFunctionNArguments* args) noexcept {
-    if (args->N != 1 || !args->valid[0]) return;
     auto* ctx = reinterpret_cast<ExactRayContext*>(args->context);
     const auto* g = static_cast<const VolumeGeometry*>(args->geometryUserPtr);
-    const TraceHit hit = g->trace(g->user, *ctx->ray, false);
-    RTCRay* ray = reinterpret_cast<RTCRay*>(args->ray);
-    if (hit.is_hit() && hit.t <= ray->tfar) ray->tfar = -INFINITY;   // Embree's "occluded" mark
+    for (unsigned i = 0; i < args->N && i < EmbreeVolumeScene::kPacket; ++i) {
+        if (!args->valid[i]) continue;
+        const TraceHit hit = g->trace(g->user, ctx->rays[i], false);
+        float& tfar = RTCRayN_tfar(args->ray, args->N, i);
+        if (hit.is_hit() && hit.t <= tfar) tfar = -INFINITY;   // Embree's "occluded" mark
+    }
 }
 
 void error_callback(void* user, RTCError code, const char* message) {
@@ -119,7 +125,7 @@ void EmbreeVolumeScene::commit() {
 TraceHit EmbreeVolumeScene::intersect(const Ray& ray, bool want_normal) const {
     ExactRayContext ctx;
     rtcInitIntersectContext(&ctx.base);
-    ctx.ray = &ray;
+    ctx.rays = &ray;
     ctx.want_normal = want_normal;
     RTCRayHit rh{};
     rh.ray.org_x = float(ray.origin[0]);
@@ -135,7 +141,35 @@ TraceHit EmbreeVolumeScene::intersect(const Ray& ray, bool want_normal) const {
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(impl_->scene, &ctx.base, &rh);
-    return ctx.hit;
+    return ctx.hits[0];
+}
+
+void EmbreeVolumeScene::intersect_packet(const Ray* rays, int count, bool want_normal, TraceHit* hits) const {
+    ExactRayContext ctx;
+    rtcInitIntersectContext(&ctx.base);
+    ctx.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;   // neighbouring pixels of one tile row
+    ctx.rays = rays;
+    ctx.want_normal = want_normal;
+    alignas(32) RTCRayHit8 rh{};
+    alignas(32) int valid[kPacket];
+    for (int i = 0; i < kPacket; ++i) {
+        valid[i] = i < count ? -1 : 0;
+        const Ray& r = rays[i < count ? i : 0];
+        rh.ray.org_x[i] = float(r.origin[0]);
+        rh.ray.org_y[i] = float(r.origin[1]);
+        rh.ray.org_z[i] = float(r.origin[2]);
+        rh.ray.dir_x[i] = float(r.dir[0]);
+        rh.ray.dir_y[i] = float(r.dir[1]);
+        rh.ray.dir_z[i] = float(r.dir[2]);
+        rh.ray.tnear[i] = 0.0f;
+        rh.ray.tfar[i] = std::numeric_limits<float>::infinity();
+        rh.ray.mask[i] = 0xffffffffu;
+        rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, impl_->scene, &ctx.base, &rh);
+    for (int i = 0; i < count; ++i) hits[i] = ctx.hits[i];
 }
 
 }  // namespace octiso
