@@ -34,6 +34,10 @@ template <typename T> constexpr ScalarType scalar_type_of() {
     else { static_assert(std::is_same_v<T, double>, "unsupported scalar type"); return ScalarType::f64; }
 }
 
+/// Applies M to each stored scalar type: explicit instantiations in the .cpp files that own a
+/// template write `OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)` instead of eight lines.
+#define OCTISO_FOR_EACH_SCALAR_TYPE(M) M(uint8_t) M(int8_t) M(uint16_t) M(int16_t) M(uint32_t) M(int32_t) M(float) M(double)
+
 /// The single runtime-to-template switch: calls f(T{}) with the C++ type of `t`.
 template <typename F> decltype(auto) dispatch_scalar_type(ScalarType t, F&& f) {
     switch (t) {

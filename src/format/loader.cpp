@@ -1,6 +1,7 @@
 // OctFile: maps a .oct file read-only, validates header and section table at open (cheap, all of
-// it), and each step's sections on first use (checksums, then every index; validate.cpp). Steps
-// are handed out as zero-copy Octree<T> views into the mapping.
+// it, without touching any step's bytes), and each step's sections on first use (padding,
+// checksums, then every index; validate.cpp), so a mapped series only becomes resident for the
+// steps used. Steps are handed out as zero-copy Octree<T> views into the mapping.
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -60,6 +61,7 @@ struct OctFile::Impl {
     void map_file();
     void check_header();
     void check_table();
+    void check_step_padding(uint32_t k) const;
 
     template <typename T> OctreeArrays<T> arrays(uint32_t k) const {
         OctreeArrays<T> a;
@@ -83,6 +85,7 @@ struct OctFile::Impl {
             fail("step " + num(k) + " does not exist (expected 0 .. " + num(info.step_count - 1) + ")");
         StepState& st = steps[k];
         std::call_once(st.once, [&] {
+            check_step_padding(k);
             if (verify == Verify::Full)
                 for (int d = 0; d < info.dmax; ++d) format::verify_section_checksum(path, base, section(k, d));
             st.sizes = dispatch_scalar_type(info.type, [&](auto t) {
@@ -228,7 +231,9 @@ void OctFile::Impl::check_table() {
         const uint64_t at = format::align_up(end);
         if (s.offset != at)
             fail(name + ": not at its canonical offset (expected " + num(at) + ", found " + num(s.offset) + ")");
-        if (!all_zero(base + end, at - end)) fail(name + ": padding before the section is not zero");
+        // The zero padding before each section is checked with its step (check_step_padding):
+        // reading it here would fault in a page of every step at open, and a mapped series
+        // should only become resident for the steps that are used (issue 6).
         end = s.offset + s.bytes;   // <= bytes, checked above
     }
     const uint64_t at = format::align_up(end);
@@ -238,6 +243,18 @@ void OctFile::Impl::check_table() {
     if (h.section_table_offset + table_bytes != bytes)
         fail("bytes after the section table (expected the file to end at " + num(h.section_table_offset + table_bytes) +
              ", found " + num(bytes) + " bytes)");
+}
+
+// 4. Per step, at first use: the zero padding in front of each of its sections (canonical
+//    offsets were checked at open, so each gap is [end of the previous region, offset), < 64 bytes).
+void OctFile::Impl::check_step_padding(uint32_t k) const {
+    for (int d = 0; d < info.dmax; ++d) {
+        const uint64_t i = uint64_t(k) * uint64_t(info.dmax) + uint64_t(d);
+        const uint64_t end = i == 0 ? sizeof(FileHeader) : table[i - 1].offset + table[i - 1].bytes;
+        const SectionEntry& s = table[i];
+        if (!all_zero(base + end, s.offset - end))
+            fail("section " + num(i) + " (step " + num(k) + ", depth " + num(d) + "): padding before the section is not zero");
+    }
 }
 
 OctFile::OctFile() : impl_(std::make_unique<Impl>()) {}
@@ -271,13 +288,8 @@ template <typename T> Octree<T> OctFile::step(uint32_t k) const {
 
 StepSizes OctFile::step_sizes(uint32_t k) const { return impl_->ensure_valid(k); }
 
-template Octree<uint8_t> OctFile::step<uint8_t>(uint32_t) const;
-template Octree<int8_t> OctFile::step<int8_t>(uint32_t) const;
-template Octree<uint16_t> OctFile::step<uint16_t>(uint32_t) const;
-template Octree<int16_t> OctFile::step<int16_t>(uint32_t) const;
-template Octree<uint32_t> OctFile::step<uint32_t>(uint32_t) const;
-template Octree<int32_t> OctFile::step<int32_t>(uint32_t) const;
-template Octree<float> OctFile::step<float>(uint32_t) const;
-template Octree<double> OctFile::step<double>(uint32_t) const;
+#define OCTISO_INSTANTIATE(T) template Octree<T> OctFile::step<T>(uint32_t) const;
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
+#undef OCTISO_INSTANTIATE
 
 }  // namespace octiso

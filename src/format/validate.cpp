@@ -167,14 +167,7 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
 
 #define OCTISO_INSTANTIATE(T) \
     template StepSizes validate_tree<T>(const std::string&, const OctreeArrays<T>&, uint32_t);
-OCTISO_INSTANTIATE(uint8_t)
-OCTISO_INSTANTIATE(int8_t)
-OCTISO_INSTANTIATE(uint16_t)
-OCTISO_INSTANTIATE(int16_t)
-OCTISO_INSTANTIATE(uint32_t)
-OCTISO_INSTANTIATE(int32_t)
-OCTISO_INSTANTIATE(float)
-OCTISO_INSTANTIATE(double)
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
 #undef OCTISO_INSTANTIATE
 
 }  // namespace octiso::format

@@ -174,13 +174,8 @@ void OctWriter::finish() {
 
 uint64_t OctWriter::bytes_written() const { return impl_->pos; }
 
-template void OctWriter::add_step<uint8_t>(const Octree<uint8_t>&);
-template void OctWriter::add_step<int8_t>(const Octree<int8_t>&);
-template void OctWriter::add_step<uint16_t>(const Octree<uint16_t>&);
-template void OctWriter::add_step<int16_t>(const Octree<int16_t>&);
-template void OctWriter::add_step<uint32_t>(const Octree<uint32_t>&);
-template void OctWriter::add_step<int32_t>(const Octree<int32_t>&);
-template void OctWriter::add_step<float>(const Octree<float>&);
-template void OctWriter::add_step<double>(const Octree<double>&);
+#define OCTISO_INSTANTIATE(T) template void OctWriter::add_step<T>(const Octree<T>&);
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
+#undef OCTISO_INSTANTIATE
 
 }  // namespace octiso

@@ -335,14 +335,7 @@ template <typename T> OctreeData<T> build_octree(const VolumeView<T>& volume, co
 #define OCTISO_INSTANTIATE(T)                                                               \
     template class OctreeData<T>;                                                           \
     template OctreeData<T> build_octree<T>(const VolumeView<T>&, const BuildOptions&);
-OCTISO_INSTANTIATE(uint8_t)
-OCTISO_INSTANTIATE(int8_t)
-OCTISO_INSTANTIATE(uint16_t)
-OCTISO_INSTANTIATE(int16_t)
-OCTISO_INSTANTIATE(uint32_t)
-OCTISO_INSTANTIATE(int32_t)
-OCTISO_INSTANTIATE(float)
-OCTISO_INSTANTIATE(double)
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
 #undef OCTISO_INSTANTIATE
 
 }  // namespace octiso

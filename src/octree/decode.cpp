@@ -103,13 +103,8 @@ template <typename T> void decode_to_dense(const Octree<T>& octree, T* out) {
     tbb::parallel_for(size_t(0), pieces.size(), [&](size_t i) { dec.fill(pieces[i]); });
 }
 
-template void decode_to_dense<uint8_t>(const Octree<uint8_t>&, uint8_t*);
-template void decode_to_dense<int8_t>(const Octree<int8_t>&, int8_t*);
-template void decode_to_dense<uint16_t>(const Octree<uint16_t>&, uint16_t*);
-template void decode_to_dense<int16_t>(const Octree<int16_t>&, int16_t*);
-template void decode_to_dense<uint32_t>(const Octree<uint32_t>&, uint32_t*);
-template void decode_to_dense<int32_t>(const Octree<int32_t>&, int32_t*);
-template void decode_to_dense<float>(const Octree<float>&, float*);
-template void decode_to_dense<double>(const Octree<double>&, double*);
+#define OCTISO_INSTANTIATE(T) template void decode_to_dense<T>(const Octree<T>&, T*);
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
+#undef OCTISO_INSTANTIATE
 
 }  // namespace octiso

@@ -148,14 +148,7 @@ template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& inpu
     template PreparedVolume<T> prepare_volume<T>(const VolumeView<T>&, const BuildOptions&); \
     template T clamp_target_low<T>(double);                                                   \
     template T clamp_target_high<T>(double);
-OCTISO_INSTANTIATE(uint8_t)
-OCTISO_INSTANTIATE(int8_t)
-OCTISO_INSTANTIATE(uint16_t)
-OCTISO_INSTANTIATE(int16_t)
-OCTISO_INSTANTIATE(uint32_t)
-OCTISO_INSTANTIATE(int32_t)
-OCTISO_INSTANTIATE(float)
-OCTISO_INSTANTIATE(double)
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
 #undef OCTISO_INSTANTIATE
 
 }  // namespace octiso::detail

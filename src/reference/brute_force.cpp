@@ -102,14 +102,7 @@ RefHit trace_reference(const VolumeView<T>& volume, const Placement& placement, 
                                                const Linear&);                                                \
     template RefHit trace_reference<T, Exact>(const VolumeView<T>&, const Placement&, const Ray&, double,     \
                                               const Exact&);
-OCTISO_INSTANTIATE_REFERENCE(uint8_t)
-OCTISO_INSTANTIATE_REFERENCE(int8_t)
-OCTISO_INSTANTIATE_REFERENCE(uint16_t)
-OCTISO_INSTANTIATE_REFERENCE(int16_t)
-OCTISO_INSTANTIATE_REFERENCE(uint32_t)
-OCTISO_INSTANTIATE_REFERENCE(int32_t)
-OCTISO_INSTANTIATE_REFERENCE(float)
-OCTISO_INSTANTIATE_REFERENCE(double)
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE_REFERENCE)
 #undef OCTISO_INSTANTIATE_REFERENCE
 
 }  // namespace octiso

@@ -80,13 +80,8 @@ template <typename T> uint64_t MacrocellGrid<T>::bytes() const {
     return n;
 }
 
-template class MacrocellGrid<uint8_t>;
-template class MacrocellGrid<int8_t>;
-template class MacrocellGrid<uint16_t>;
-template class MacrocellGrid<int16_t>;
-template class MacrocellGrid<uint32_t>;
-template class MacrocellGrid<int32_t>;
-template class MacrocellGrid<float>;
-template class MacrocellGrid<double>;
+#define OCTISO_INSTANTIATE(T) template class MacrocellGrid<T>;
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
+#undef OCTISO_INSTANTIATE
 
 }  // namespace octiso

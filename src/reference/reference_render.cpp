@@ -70,14 +70,7 @@ ImageError compare_frames(const Frame& frame, const Frame& reference, double vox
 #define OCTISO_INSTANTIATE(T)                                                                        \
     template Frame render_reference<T>(const VolumeView<T>&, const Placement&, const Camera&, \
                                        const std::vector<double>&);
-OCTISO_INSTANTIATE(uint8_t)
-OCTISO_INSTANTIATE(int8_t)
-OCTISO_INSTANTIATE(uint16_t)
-OCTISO_INSTANTIATE(int16_t)
-OCTISO_INSTANTIATE(uint32_t)
-OCTISO_INSTANTIATE(int32_t)
-OCTISO_INSTANTIATE(float)
-OCTISO_INSTANTIATE(double)
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
 #undef OCTISO_INSTANTIATE
 
 }  // namespace octiso

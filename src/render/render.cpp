@@ -199,14 +199,7 @@ Frame render(const Octree<T>& tree, const Placement& placement, const Camera& ca
 
 #define OCTISO_INSTANTIATE(T) \
     template Frame render<T>(const Octree<T>&, const Placement&, const Camera&, const RenderOptions&);
-OCTISO_INSTANTIATE(uint8_t)
-OCTISO_INSTANTIATE(int8_t)
-OCTISO_INSTANTIATE(uint16_t)
-OCTISO_INSTANTIATE(int16_t)
-OCTISO_INSTANTIATE(uint32_t)
-OCTISO_INSTANTIATE(int32_t)
-OCTISO_INSTANTIATE(float)
-OCTISO_INSTANTIATE(double)
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
 #undef OCTISO_INSTANTIATE
 
 }  // namespace octiso
