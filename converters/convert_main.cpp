@@ -18,6 +18,7 @@
 #include "octiso/oct_file.h"
 #include "octiso/reader.h"
 #include "octiso/synthetic.h"
+#include "octree/sparse_synthetic.h"
 
 namespace {
 
@@ -30,7 +31,9 @@ constexpr const char* kUsage =
     "                      [--nan-as V] [--threads N] [--json]\n"
     "       octiso-convert --synthetic NAME:N|NAME:NX,NY,NZ [--type T] -o OUT.oct [options]\n"
     "       octiso-convert --synthetic plume-series:N,STEPS -o SERIES.oct [options]\n"
+    "       octiso-convert --synthetic sparse-spheres:N -o OUT.oct [--json]   (N^3 virtual, e.g. 16384)\n"
     "       octiso-convert --steps A:B 'pattern_%03d.raw' -o SERIES.oct [options]\n"
+    "       octiso-convert STEP0 STEP1 ... -o SERIES.oct [options]   (a time series, one step per INPUT)\n"
     "INPUT: .nii .nii.gz .vti .vtk .mhd .mha .nrrd .nhdr, or raw (needs --dims and --type)\n"
     "NAME: sphere marschner-lobb sponge noise plume mixing plume-series\n"
     "T: u8 i8 u16 i16 u32 i32 f32 f64";
@@ -47,9 +50,11 @@ std::string mib(uint64_t bytes) {
     return s.str();
 }
 
-/// Where the steps come from: one input, a synthetic spec, or a printf pattern over A..B.
+/// Where the steps come from: one input, a list of inputs (one step each), a synthetic spec, or
+/// a printf pattern over A..B.
 struct Source {
-    std::string input;                  // single file, or the pattern with --steps
+    std::string input;                  // single file, the pattern with --steps, or the first of a list
+    std::vector<std::string> list;      // several INPUTs: step i is list[i]
     std::optional<SyntheticSpec> synthetic;
     std::optional<ScalarType> synthetic_type;
     std::array<long long, 2> steps{0, 0};
@@ -58,9 +63,11 @@ struct Source {
 
     uint32_t count() const {
         if (synthetic) return synthetic->steps;
+        if (!list.empty()) return uint32_t(list.size());
         return uint32_t(steps[1] - steps[0] + 1);
     }
     std::string step_path(uint32_t i) const {
+        if (!list.empty()) return list[i];
         return series_pattern ? cli::format_step(input, steps[0] + i, "--steps") : input;
     }
     LoadedVolume load(uint32_t i) const {
@@ -141,8 +148,10 @@ Source parse_source(cli::Args& args, std::vector<std::string>& positional) {
     }
 
     if (positional.empty()) throw Error("INPUT", "missing input file or --synthetic (see --help)");
-    if (positional.size() > 1) throw Error(positional[1], "unexpected argument (one INPUT only)");
+    if (positional.size() > 1 && steps)
+        throw Error(positional[1], "unexpected argument (--steps takes one pattern; a list of INPUTs needs no --steps)");
     src.input = positional[0];
+    if (positional.size() > 1) src.list = positional;
     if (steps) {
         src.steps = cli::parse_steps(*steps, "--steps");
         src.series_pattern = true;
@@ -228,6 +237,39 @@ void write_human(std::ostream& os, const Source& src, const StepMeta& first, con
        << threads << " threads), total " << total_seconds << " s, peak RSS " << mib(peak_rss) << "\n";
 }
 
+/// --synthetic sparse-spheres:N (f32, N^3, N >= 64): built directly as an octree, no dense array
+/// (src/octree/sparse_synthetic.h), so N may be 16384 or more. Only -o and --json apply.
+int convert_sparse_spheres(cli::Args& args, uint32_t n) {
+    const bool json = args.flag("--json");
+    const auto out = args.value("--output", "-o");
+    args.value("--synthetic");
+    args.finish();
+    if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
+    const Clock::time_point t0 = Clock::now();
+    const SparseSpheres field = sparse_spheres_layout(n);
+    const OctreeData<float> tree = build_sparse_octree<float>(field);
+    OctInfo info;
+    info.type = ScalarType::f32;
+    info.dims = field.dims;
+    info.dmax = tree.dmax;
+    OctWriter writer(*out, info);
+    writer.add_step(tree.view());
+    writer.finish();
+    const double seconds = seconds_since(t0);
+    std::cerr << "octiso-convert: sparse-spheres:" << n << " (f32 " << dims_text(field.dims)
+              << ", built directly as an octree) -> " << *out << ", " << mib(writer.bytes_written()) << ", " << seconds << " s\n";
+    if (json) {
+        cli::JsonWriter j(std::cout);
+        j.begin_object().field("input", "sparse-spheres:" + std::to_string(n)).field("format", "synthetic");
+        j.field("output", *out).field("type", "f32");
+        j.key("dims").array(std::array<uint64_t, 3>{n, n, n});
+        j.field("steps", 1).field("dmax", tree.dmax).field("file_bytes", writer.bytes_written());
+        j.field("total_seconds", seconds).end_object();
+        std::cout << "\n";
+    }
+    return 0;
+}
+
 int convert(std::vector<std::string>& argv) {
     const Clock::time_point t_start = Clock::now();
     cli::Args args(argv);
@@ -239,6 +281,9 @@ int convert(std::vector<std::string>& argv) {
         std::cerr << kUsage << "\n";
         return 2;
     }
+    for (size_t i = 0; i + 1 < argv.size(); ++i)   // sparse-spheres never makes a dense array
+        if (argv[i] == "--synthetic")
+            if (const uint32_t n = parse_sparse_spheres(argv[i + 1])) return convert_sparse_spheres(args, n);
     const bool json = args.flag("--json");
     const auto out = args.value("--output", "-o");
     BuildOptions opt;

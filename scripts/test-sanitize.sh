@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Builds octiso with AddressSanitizer + UndefinedBehaviorSanitizer (-DOCTISO_SANITIZE=ON,
+# RelWithDebInfo) into build-asan/ (or $OCTISO_ASAN_BUILD_DIR) and runs the test suite there.
+# OCTISO_SANITIZE_FILTER (a ctest -E regex) leaves out tests too slow under the sanitizers;
+# empty by default: the whole suite runs. Measured on 2 shared cores: build ~25 min from scratch
+# (incremental: minutes), ctest ~6 min (the Release ctest takes ~2.5 min).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${OCTISO_ASAN_BUILD_DIR:-$root/build-asan}
+jobs=${OCTISO_JOBS:-$(nproc)}
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOCTISO_SANITIZE=ON -DOCTISO_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" -j "$jobs"
+cd "$build"
+# halt_on_error: a report fails the test instead of scrolling past; leaks are real bugs here too.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-halt_on_error=1:detect_leaks=1:abort_on_error=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
+# Leaks inside third-party libraries (listed with their reason in lsan.supp) are not ours to fix.
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/scripts/lsan.supp}
+filter=()
+if [[ -n "${OCTISO_SANITIZE_FILTER:-}" ]]; then filter=(-E "$OCTISO_SANITIZE_FILTER"); fi
+ctest --output-on-failure -j "$jobs" "${filter[@]}"

@@ -1,0 +1,323 @@
+// build_sparse_octree: the top-down twin of build.cpp for an analytic sparse field. It follows
+// the builder's rules exactly (DFS post-order appends, leaf merging with tolerance 0, cap parents
+// from their 5^3 clamped neighbourhood, midpoint scalars, padding summaries), so the arrays are
+// the ones build_octree would produce from the dense grid. The one addition: a node whose own
+// voxels miss every blob support is uniform, so it is a leaf without descending; its cell range
+// is the background plus the blob values on its forward layer, enumerated from the supports.
+#include "octree/sparse_synthetic.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "octiso/error.h"
+
+namespace octiso {
+
+template <typename T> T SparseSpheres::value(uint32_t x, uint32_t y, uint32_t z) const {
+    double v = background;
+    for (const SparseBlob& b : blobs) {
+        const double dx = double(x) - b.centre[0], dy = double(y) - b.centre[1], dz = double(z) - b.centre[2];
+        const double d2 = dx * dx + dy * dy + dz * dz, r2 = b.radius * b.radius;
+        if (d2 < r2) {
+            v = background + b.peak * (1 - d2 / r2);
+            break;
+        }
+    }
+    if constexpr (std::is_floating_point_v<T>) {
+        return T(v);
+    } else {
+        v = std::round(v);
+        v = std::clamp(v, double(std::numeric_limits<T>::lowest()), double(std::numeric_limits<T>::max()));
+        return T(v);
+    }
+}
+
+std::array<std::array<int64_t, 3>, 2> SparseSpheres::support(size_t i) const {
+    const SparseBlob& b = blobs[i];
+    const uint32_t n[3] = {dims.x, dims.y, dims.z};
+    std::array<std::array<int64_t, 3>, 2> box;
+    for (int a = 0; a < 3; ++a) {
+        // One voxel of slack on each side: a superset of {d2 < r2} is all correctness needs.
+        box[0][a] = std::max<int64_t>(0, int64_t(std::floor(b.centre[a] - b.radius)) - 1);
+        box[1][a] = std::min<int64_t>(int64_t(n[a]) - 1, int64_t(std::ceil(b.centre[a] + b.radius)) + 1);
+    }
+    return box;
+}
+
+SparseSpheres sparse_spheres_layout(uint32_t n) {
+    const double N = double(n);
+    SparseSpheres f;
+    f.dims = {n, n, n};
+    f.background = 0;
+    f.blobs = {
+        {{9.3, 11.7, 8.4}, 6.5, 100},                                  // near the origin
+        {{N - 7.6, N - 8.2, N - 6.9}, 5.3, 100},                       // far corner: cells ~N-13 .. N-2
+        {{N - 2.4, N / 2 + 0.37, N - 3.1}, 7.7, 100},                  // cut by the far x and z faces
+        {{N / 2 + 0.41, N / 3 + 0.13, 2 * N / 3 + 0.77}, 11.3, 100},   // straddles the x mid-plane
+        {{N / 4 + 0.5, 3 * N / 4 + 0.25, N / 8 + 0.125}, 4.2, 100},
+    };
+    return f;
+}
+
+uint32_t parse_sparse_spheres(std::string_view text, const std::string& flag) {
+    constexpr std::string_view kName = "sparse-spheres";
+    if (text.substr(0, kName.size()) != kName) return 0;
+    if (text.size() == kName.size() || text[kName.size()] != ':')
+        throw Error(flag, "expected sparse-spheres:N, found '" + std::string(text) + "'");
+    const std::string n_text(text.substr(kName.size() + 1));
+    char* end = nullptr;
+    const unsigned long long n = std::strtoull(n_text.c_str(), &end, 10);
+    if (n_text.empty() || *end != '\0' || n_text[0] == '-' || n < 64 || n > Dims::kMaxExtent)
+        throw Error(flag, "sparse-spheres:N needs an integer N in [64, " + std::to_string(Dims::kMaxExtent) +
+                              "], found '" + n_text + "'");
+    return uint32_t(n);
+}
+
+namespace {
+
+/// What a finished subtree tells its parent (the same fields as build.cpp's Summary).
+template <typename T> struct Summary {
+    T scalar;
+    T cell_min, cell_max;   ///< empty: min > max
+    T data_lo, data_hi;
+    bool is_leaf;
+    bool is_padding;
+};
+
+template <typename T> class SparseBuilder {
+public:
+    explicit SparseBuilder(const SparseSpheres& f) : f_(f), dims_(f.dims), dmax_(dmax_for(f.dims)) {
+        for (size_t i = 0; i < f.blobs.size(); ++i) supports_.push_back(f.support(i));
+        nodes_.resize(size_t(dmax_));
+        leaves_.assign(size_t(dmax_), 0);
+        background_ = convert(f.background);
+    }
+
+    OctreeData<T> run() {
+        build(0, Coord{});
+        OctreeData<T> out;
+        out.dims = dims_;
+        out.dmax = dmax_;
+        out.nodes.resize(size_t(dmax_ - 1));
+        out.stats.nodes_per_depth.assign(size_t(dmax_), 0);
+        out.stats.scalar_leaves_per_depth = leaves_;
+        for (int d = 0; d <= dmax_ - 2; ++d) {
+            const auto& v = nodes_[size_t(d)];
+            out.nodes[size_t(d)] = UninitArray<InteriorNode<T>>::make(v.size());
+            std::copy(v.begin(), v.end(), out.nodes[size_t(d)].data.get());
+            out.stats.nodes_per_depth[size_t(d)] = v.size();
+            out.stats.interior_bytes += v.size() * sizeof(InteriorNode<T>);
+        }
+        out.caps = UninitArray<Cap<T>>::make(caps_.size());
+        std::copy(caps_.begin(), caps_.end(), out.caps.data.get());
+        out.stats.nodes_per_depth[size_t(dmax_ - 1)] = caps_.size();
+        out.stats.minmax_bytes = out.stats.interior_bytes / sizeof(InteriorNode<T>) * 16 * sizeof(T);
+        out.stats.cap_bytes = caps_.size() * sizeof(Cap<T>);
+        return out;
+    }
+
+private:
+    using Box = std::array<std::array<int64_t, 3>, 2>;
+
+    static T convert(double v) {
+        if constexpr (std::is_floating_point_v<T>) return T(v);
+        else return T(std::clamp(std::round(v), double(std::numeric_limits<T>::lowest()), double(std::numeric_limits<T>::max())));
+    }
+
+    uint32_t child_bit(int d) const { return 1u << (dmax_ - d - 1); }
+    bool outside(Coord o) const { return o.x >= dims_.x || o.y >= dims_.y || o.z >= dims_.z; }
+    static Coord child_origin(Coord o, int c, uint32_t half) {
+        return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
+    }
+    static Summary<T> padding() {
+        return {T{}, std::numeric_limits<T>::max(), std::numeric_limits<T>::lowest(), T{}, T{}, true, true};
+    }
+    static T midpoint(T lo, T hi) { return T(double(lo) + (double(hi) - double(lo)) / 2); }
+
+    /// The node's data voxels [o, o + side) clipped to the data.
+    Box voxel_box(Coord o, uint64_t side) const {
+        const uint64_t n[3] = {dims_.x, dims_.y, dims_.z}, lo[3] = {o.x, o.y, o.z};
+        Box b;
+        for (int a = 0; a < 3; ++a) b[0][a] = int64_t(lo[a]), b[1][a] = int64_t(std::min(lo[a] + side, n[a]) - 1);
+        return b;
+    }
+    static bool overlap(const Box& a, const Box& b) {
+        for (int i = 0; i < 3; ++i)
+            if (a[1][i] < b[0][i] || b[1][i] < a[0][i] || a[0][i] > a[1][i] || b[0][i] > b[1][i]) return false;
+        return true;
+    }
+    bool touches_blob(const Box& b) const {
+        for (const Box& s : supports_)
+            if (overlap(b, s)) return true;
+        return false;
+    }
+
+    /// A node (depth > 0) whose data voxels are all background: a leaf. Its cell range covers the
+    /// voxels [o, min(o + side, dims - 1)] (its cells plus the forward layer) when it has a cell.
+    Summary<T> uniform_leaf(Coord o, uint64_t side) const {
+        Summary<T> s{background_, std::numeric_limits<T>::max(), std::numeric_limits<T>::lowest(),
+                     background_, background_, true, false};
+        const uint32_t n[3] = {dims_.x, dims_.y, dims_.z}, lo[3] = {o.x, o.y, o.z};
+        Box e;
+        for (int a = 0; a < 3; ++a) {
+            if (n[a] < 2 || lo[a] > n[a] - 2) return s;   // no data cell: empty range
+            e[0][a] = lo[a];
+            e[1][a] = int64_t(std::min<uint64_t>(uint64_t(lo[a]) + side, n[a] - 1));
+        }
+        s.cell_min = s.cell_max = background_;   // the node's own voxels are background
+        for (const Box& sup : supports_) {
+            if (!overlap(e, sup)) continue;
+            for (int64_t z = std::max(e[0][2], sup[0][2]); z <= std::min(e[1][2], sup[1][2]); ++z)
+                for (int64_t y = std::max(e[0][1], sup[0][1]); y <= std::min(e[1][1], sup[1][1]); ++y)
+                    for (int64_t x = std::max(e[0][0], sup[0][0]); x <= std::min(e[1][0], sup[1][0]); ++x) {
+                        const T v = f_.value<T>(uint32_t(x), uint32_t(y), uint32_t(z));
+                        s.cell_min = std::min(s.cell_min, v);
+                        s.cell_max = std::max(s.cell_max, v);
+                    }
+        }
+        return s;
+    }
+
+    Summary<T> build(int d, Coord o) {
+        if (outside(o)) return padding();
+        const uint64_t side = uint64_t(1) << (dmax_ - d);
+        if (d > 0 && !touches_blob(voxel_box(o, side))) return uniform_leaf(o, side);
+        if (d == dmax_ - 2) return build_cap_parent(o);
+        Summary<T> ch[8];
+        const uint64_t start = nodes_[size_t(d + 1)].size();
+        for (int c = 0; c < 8; ++c) ch[c] = build(d + 1, child_origin(o, c, child_bit(d)));
+        return combine(d, ch, start);
+    }
+
+    // The two functions below repeat build.cpp's Builder::combine and build_cap_parent rules for
+    // tolerance 0 (the tests compare the arrays with build_octree's, node for node).
+    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start) {
+        bool all_leaves = true, any_data = false;
+        T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
+        T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
+        for (int c = 0; c < 8; ++c) {
+            all_leaves &= ch[c].is_leaf;
+            if (!ch[c].is_padding) {
+                any_data = true;
+                lo = std::min(lo, ch[c].data_lo);
+                hi = std::max(hi, ch[c].data_hi);
+            }
+            if (ch[c].cell_min <= ch[c].cell_max) {
+                cmin = std::min(cmin, ch[c].cell_min);
+                cmax = std::max(cmax, ch[c].cell_max);
+            }
+        }
+        if (d > 0 && all_leaves) {
+            if (!any_data) return padding();
+            if (lo == hi) return {lo, cmin, cmax, lo, hi, true, false};
+        }
+        if (start > std::numeric_limits<uint32_t>::max())
+            throw Error("sparse-spheres", "octree too large: more than 2^32 nodes at depth " + std::to_string(d + 1));
+        InteriorNode<T> n{};
+        uint8_t mask = 0;
+        for (int c = 0; c < 8; ++c) {
+            n.scalar[c] = ch[c].scalar;
+            n.min[c] = ch[c].cell_min;
+            n.max[c] = ch[c].cell_max;
+            if (!ch[c].is_leaf) mask = uint8_t(mask | (1u << c));
+        }
+        n.child_mask = mask;
+        n.child_start = uint32_t(start);
+        nodes_[size_t(d)].push_back(n);
+        leaves_[size_t(d)] += uint64_t(8 - std::popcount(unsigned(mask)));
+        return {any_data ? midpoint(lo, hi) : T{}, cmin, cmax, lo, hi, false, !any_data};
+    }
+
+    Summary<T> build_cap_parent(Coord o) {
+        T L[5][5][5];
+        uint32_t xs[5], ys[5], zs[5];
+        for (uint32_t i = 0; i < 5; ++i) {
+            xs[i] = std::min(o.x + i, dims_.x - 1);
+            ys[i] = std::min(o.y + i, dims_.y - 1);
+            zs[i] = std::min(o.z + i, dims_.z - 1);
+        }
+        for (int z = 0; z < 5; ++z)
+            for (int y = 0; y < 5; ++y)
+                for (int x = 0; x < 5; ++x) L[z][y][x] = f_.value<T>(xs[x], ys[y], zs[z]);
+
+        Summary<T> ch[8];
+        const uint64_t start = caps_.size();
+        for (int c = 0; c < 8; ++c) {
+            const int bx = (c & 4) ? 2 : 0, by = (c & 2) ? 2 : 0, bz = (c & 1) ? 2 : 0;
+            const Coord g{o.x + uint32_t(bx), o.y + uint32_t(by), o.z + uint32_t(bz)};
+            if (outside(g)) { ch[c] = padding(); continue; }
+            const int ex = int(std::min<uint32_t>(2, dims_.x - g.x));
+            const int ey = int(std::min<uint32_t>(2, dims_.y - g.y));
+            const int ez = int(std::min<uint32_t>(2, dims_.z - g.z));
+            T lo = L[bz][by][bx], hi = lo;
+            for (int z = 0; z < ez; ++z)
+                for (int y = 0; y < ey; ++y)
+                    for (int x = 0; x < ex; ++x) {
+                        lo = std::min(lo, L[bz + z][by + y][bx + x]);
+                        hi = std::max(hi, L[bz + z][by + y][bx + x]);
+                    }
+            T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
+            if (dims_.x - g.x >= 2 && dims_.y - g.y >= 2 && dims_.z - g.z >= 2) {
+                const int cx = int(std::min<uint32_t>(3, dims_.x - g.x));
+                const int cy = int(std::min<uint32_t>(3, dims_.y - g.y));
+                const int cz = int(std::min<uint32_t>(3, dims_.z - g.z));
+                for (int z = 0; z < cz; ++z)
+                    for (int y = 0; y < cy; ++y)
+                        for (int x = 0; x < cx; ++x) {
+                            cmin = std::min(cmin, L[bz + z][by + y][bx + x]);
+                            cmax = std::max(cmax, L[bz + z][by + y][bx + x]);
+                        }
+            }
+            if (lo == hi) {
+                ch[c] = {lo, cmin, cmax, lo, hi, true, false};
+                continue;
+            }
+            Cap<T> cap;
+            for (int k = 0; k < 8; ++k) cap.voxel[k] = L[bz + (k & 1)][by + ((k >> 1) & 1)][bx + ((k >> 2) & 1)];
+            caps_.push_back(cap);
+            ch[c] = {midpoint(lo, hi), cmin, cmax, lo, hi, false, false};
+        }
+        return combine(dmax_ - 2, ch, start);
+    }
+
+    const SparseSpheres& f_;
+    const Dims dims_;
+    const int dmax_;
+    T background_{};
+    std::vector<Box> supports_;
+    std::vector<std::vector<InteriorNode<T>>> nodes_;   // by depth, DFS post-order
+    std::vector<Cap<T>> caps_;
+    std::vector<uint64_t> leaves_;
+};
+
+}  // namespace
+
+template <typename T> OctreeData<T> build_sparse_octree(const SparseSpheres& field) {
+    const Dims d = field.dims;
+    if (d.x == 0 || d.y == 0 || d.z == 0 || d.max_extent() > Dims::kMaxExtent)
+        throw Error("sparse-spheres", "dims out of range (expected 1 .. " + std::to_string(Dims::kMaxExtent) + ")");
+    bool finite = std::isfinite(field.background);
+    for (const SparseBlob& b : field.blobs)
+        finite &= std::isfinite(b.peak) && std::isfinite(b.radius) && b.radius > 0 && std::isfinite(b.centre[0]) &&
+                  std::isfinite(b.centre[1]) && std::isfinite(b.centre[2]);
+    if (!finite) throw Error("sparse-spheres", "background, centres, radii and peaks must be finite, radii > 0");
+    return SparseBuilder<T>(field).run();
+}
+
+#define OCTISO_INSTANTIATE(T)                                                        \
+    template T SparseSpheres::value<T>(uint32_t, uint32_t, uint32_t) const;          \
+    template OctreeData<T> build_sparse_octree<T>(const SparseSpheres&);
+OCTISO_INSTANTIATE(uint8_t)
+OCTISO_INSTANTIATE(int8_t)
+OCTISO_INSTANTIATE(uint16_t)
+OCTISO_INSTANTIATE(int16_t)
+OCTISO_INSTANTIATE(uint32_t)
+OCTISO_INSTANTIATE(int32_t)
+OCTISO_INSTANTIATE(float)
+OCTISO_INSTANTIATE(double)
+#undef OCTISO_INSTANTIATE
+
+}  // namespace octiso
