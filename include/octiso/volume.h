@@ -53,7 +53,8 @@ template <typename F> decltype(auto) dispatch_scalar_type(ScalarType t, F&& f) {
     return f(double{});
 }
 
-/// Grid size in voxels. Each extent is in [1, kMaxExtent]; voxels() cannot overflow 64 bits.
+/// Grid size in voxels. Each extent is in [1, kMaxExtent] (2^30). voxels() can overflow 64 bits
+/// (2^90 at most): call it only on dims that passed checked_volume_bytes (every reader does).
 struct Dims {
     uint32_t x = 0, y = 0, z = 0;
     static constexpr uint32_t kMaxExtent = 1u << 30;   // keeps N = 2^dmax representable in uint32

@@ -3,6 +3,7 @@
 // validated (checksums and indices) before it is reported.
 #include <cerrno>
 #include <cstdio>
+#include <unistd.h>
 #include <cstring>
 #include <iomanip>
 #include <iostream>
@@ -35,6 +36,13 @@ struct Extract {
 void extract_raw(const OctFile& file, Extract& ex) {
     const OctInfo& info = file.info();
     ex.bytes = checked_volume_bytes(info.dims, info.type, file.path());
+    // The dense array is decoded in memory: refuse up front, naming the size, rather than fail
+    // on allocation (a sparse 16384^3 octree is 98 KB on disk and 16 TiB as an array).
+    const uint64_t memory = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
+    if (ex.bytes > memory)
+        throw Error("--extract-raw", "step " + std::to_string(ex.step) + " of " + file.path() + " is " +
+                                         std::to_string(ex.bytes) + " bytes as a dense array, more than this machine's " +
+                                         std::to_string(memory) + " bytes of memory");
     dispatch_scalar_type(info.type, [&](auto t) {
         using T = decltype(t);
         const Octree<T> tree = file.step<T>(ex.step);
