@@ -49,6 +49,11 @@ Camera frame_data_box(Dims dims, const Placement& placement, int width, int heig
     return c;
 }
 
+int tile_size_for(int width, int height, int requested) {
+    if (requested > 0) return requested;
+    return int64_t(width) * height / (16 * 16) >= 4096 ? 16 : 8;
+}
+
 RootFinder parse_root_finder_name(const std::string& name) {
     const auto kind = parse_root_finder(name);
     if (!kind) throw Error("--root-finder", "expected neubauer, schwarze, linear or exact, found '" + name + "'");
@@ -98,7 +103,7 @@ void validate(const Camera& camera, const RenderOptions& options) {
     const auto side = vec_cross(f, camera.up);
     if (!(vec_dot(side, side) > 1e-24 * vec_dot(f, f) * std::max(vec_dot(camera.up, camera.up), 1e-300)))
         throw Error("--up", "must not be parallel to the viewing direction (or zero)");
-    if (options.tile_size < 1) throw Error("tile_size", "must be positive");
+    if (options.tile_size < 0) throw Error("tile_size", "must not be negative");
 }
 
 template <typename T, class Finder>
@@ -135,7 +140,7 @@ Frame render_with(const Octree<T>& tree, const Placement& placement, const Camer
     static const SrgbTable to_srgb8;
     std::atomic<uint64_t> hits{0};
     const auto t0 = std::chrono::steady_clock::now();
-    const int ts = options.tile_size;
+    const int ts = tile_size_for(W, H, options.tile_size);
     tbb::parallel_for(
         tbb::blocked_range2d<int>(0, H, ts, 0, W, ts),
         [&](const tbb::blocked_range2d<int>& tile) {
