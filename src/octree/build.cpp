@@ -237,7 +237,7 @@ template <typename U> void move_into(UninitArray<U>& dst, uint64_t& at, std::vec
 /// Gives freed heap pages back to the OS. The pieces' vectors are mostly below glibc's dynamic
 /// mmap threshold, so they live in the worker threads' arenas, and free() alone keeps them
 /// resident while the final arrays fill: that doubled the output in peak RSS (octiso-bench
-/// compression, 512^3 plume: 1.26x of input + output before, see docs/bench/compression.md).
+/// compression, 512^3 plume: 1.26x of input + output before, see BENCHMARKS.md, compression).
 void release_free_memory() { ::malloc_trim(0); }
 
 template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const BuildOptions& options) {

@@ -13,7 +13,7 @@
 // Corners: inside a cap, a forward neighbour in the same cap is a direct read (octant & dir == 0),
 // otherwise neighbour finding climbs the parent trace this traversal keeps (App. B.2); each of the
 // 7 forward neighbour blocks of a cap is located once per cap visit and then read directly
-// (measured by `octiso-bench grid`: +3-5 % frames/s on octree data, docs/bench/grid.md).
+// (measured by `octiso-bench grid`: +3-5 % frames/s on octree data, BENCHMARKS.md, grid section).
 // The corner source is a policy only for the grid benchmark's "octree over array data" variant
 // (Knoll 2006 Table 3); with the default, OctreeCornerSource, the policy costs nothing.
 #pragma once
