@@ -229,42 +229,9 @@ private:
         }
     }
 
-    /// Cell-local coordinates a hair off a face are put on it (as traverse.h), so shared face
-    /// values agree bitwise between neighbouring cells.
-    static double snap_to_face(double p) {
-        constexpr double kEps = 1e-12;
-        if (std::fabs(p) < kEps) return 0.0;
-        if (std::fabs(p - 1.0) < kEps) return 1.0;
-        return p;
-    }
-
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
-        double lo = corner[0], hi = corner[0];
-        for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
-        if (!any_iso_in(lo, hi)) return false;
-        const std::array<double, 3> o_cell{w.ray.origin[0] - double(v.x), w.ray.origin[1] - double(v.y),
-                                           w.ray.origin[2] - double(v.z)};
-        std::array<double, 3> p_in, p_out;
-        for (int a = 0; a < 3; ++a) {
-            p_in[a] = snap_to_face(o_cell[a] + t_in * w.ray.dir[a]);
-            p_out[a] = snap_to_face(o_cell[a] + t_out * w.ray.dir[a]);
-        }
-        double best_s = 2.0;
-        int best = -1;
-        for (int i = 0; i < iso_count_; ++i) {
-            if (!(lo <= iso_[i] && iso_[i] <= hi)) continue;
-            const double s = first_root(finder_, corner, iso_[i], p_in, p_out, closed_end);
-            if (s >= 0 && s < best_s) best_s = s, best = i;
-        }
-        if (best < 0) return false;
-        w.hit.t = t_in + best_s * (t_out - t_in);
-        w.hit.iso_index = best;
-        if (w.want_normal) {
-            std::array<double, 3> p_hit;
-            for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + best_s * (p_out[a] - p_in[a]);
-            w.hit.normal = world_normal(corner, p_hit, placement_.spacing, w.world_dir);
-        }
-        return true;
+        const CellQuery q{iso_, iso_count_, &w.ray, &placement_.spacing, &w.world_dir, w.want_normal};
+        return intersect_cell(finder_, q, v, corner, t_in, t_out, closed_end, w.hit);
     }
 
     const MacrocellGrid<T>& grid_;
