@@ -30,6 +30,7 @@
 #include "octiso/build.h"
 #include "octiso/error.h"
 #include "octree/prepare.h"
+#include "octree/summary.h"
 
 namespace octiso {
 
@@ -48,14 +49,7 @@ template <typename T> Octree<T> OctreeData<T>::view() const {
 
 namespace {
 
-/// What a finished subtree tells its parent.
-template <typename T> struct Summary {
-    T scalar;              ///< the value of a leaf; the midpoint of the data range otherwise
-    T cell_min, cell_max;  ///< range over the data cells with lower corner inside; empty: min > max
-    T data_lo, data_hi;    ///< range of the data voxels inside (meaningless when is_padding)
-    bool is_leaf;
-    bool is_padding;       ///< no data voxel inside at all
-};
+using detail::Summary;
 
 /// One piece's output: node records by absolute depth, caps, leaf counts by depth.
 template <typename T> struct Sink {
@@ -72,15 +66,11 @@ public:
 
     uint32_t child_bit(int d) const { return 1u << (dmax_ - d - 1); }
 
-    static Summary<T> padding() {
-        return {T{}, std::numeric_limits<T>::max(), std::numeric_limits<T>::lowest(), T{}, T{}, true, true};
-    }
+    static Summary<T> padding() { return Summary<T>::padding(); }
 
     bool outside(Coord o) const { return o.x >= dims_.x || o.y >= dims_.y || o.z >= dims_.z; }
 
-    static Coord child_origin(Coord o, int c, uint32_t half) {
-        return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
-    }
+    static Coord child_origin(Coord o, int c, uint32_t half) { return detail::child_origin(o, c, half); }
 
     /// Whether values in [lo, hi] may become one value `rep` with |v - rep| <= tolerance for all.
     bool mergeable(T lo, T hi, T& rep) const {
@@ -94,10 +84,6 @@ public:
         if (double(r) - a > tolerance_ || b - double(r) > tolerance_) return false;
         rep = r;
         return true;
-    }
-
-    static T midpoint(T lo, T hi) {
-        return T(double(lo) + (double(hi) - double(lo)) / 2);
     }
 
     /// Widening of a cell range by the tolerance, so that it also bounds the stored (lossy) values.
@@ -122,40 +108,13 @@ public:
     /// Folds 8 child summaries into a leaf, or stores an interior node at depth d.
     /// `start` is the index the first stored child got at depth d+1 (local to the sink).
     Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, Sink<T>& sink) const {
-        bool all_leaves = true, any_data = false;
-        T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
-        T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
-        for (int c = 0; c < 8; ++c) {
-            all_leaves &= ch[c].is_leaf;
-            if (!ch[c].is_padding) {
-                any_data = true;
-                lo = std::min(lo, ch[c].data_lo);
-                hi = std::max(hi, ch[c].data_hi);
-            }
-            if (ch[c].cell_min <= ch[c].cell_max) {
-                cmin = std::min(cmin, ch[c].cell_min);
-                cmax = std::max(cmax, ch[c].cell_max);
-            }
-        }
-        // The root is always stored, so that every tree has an interior node at depth 0.
-        if (d > 0 && all_leaves) {
-            if (!any_data) return padding();
-            T rep;
-            if (mergeable(lo, hi, rep)) return {rep, cmin, cmax, lo, hi, true, false};
-        }
-        InteriorNode<T> n{};
-        uint8_t mask = 0;
-        for (int c = 0; c < 8; ++c) {
-            n.scalar[c] = ch[c].scalar;
-            n.min[c] = ch[c].cell_min;
-            n.max[c] = ch[c].cell_max;
-            if (!ch[c].is_leaf) mask = uint8_t(mask | (1u << c));
-        }
-        n.child_mask = mask;
-        n.child_start = uint32_t(start);   // local; offset and range-checked at concatenation
+        Summary<T> out;
+        InteriorNode<T> n;
+        auto merge = [this](T lo, T hi, T& rep) { return mergeable(lo, hi, rep); };
+        if (detail::fold_children(d, ch, start, merge, out, n)) return out;
         sink.nodes[size_t(d)].push_back(n);
-        sink.leaves[size_t(d)] += uint64_t(8 - std::popcount(unsigned(mask)));
-        return {any_data ? midpoint(lo, hi) : T{}, cmin, cmax, lo, hi, false, !any_data};
+        sink.leaves[size_t(d)] += uint64_t(8 - std::popcount(unsigned(n.child_mask)));
+        return out;
     }
 
     /// A node at depth dmax-2: 4^3 voxels in 8 blocks of 2^3, each a scalar leaf or a cap.
@@ -176,48 +135,12 @@ public:
                 for (int x = 0; x < 5; ++x) L[z][y][x] = v_.load(row + xs[x]);
             }
 
-        // 2. Each block: data range over its data voxels, cell range over the 3^3 box.
+        // 2. Each block: a scalar leaf or a cap (summary.h).
         Summary<T> ch[8];
         const uint64_t start = sink.caps.size();
-        for (int c = 0; c < 8; ++c) {
-            const int bx = (c & 4) ? 2 : 0, by = (c & 2) ? 2 : 0, bz = (c & 1) ? 2 : 0;
-            const Coord g{o.x + uint32_t(bx), o.y + uint32_t(by), o.z + uint32_t(bz)};
-            if (outside(g)) { ch[c] = padding(); continue; }
-            const int ex = int(std::min<uint32_t>(2, dims_.x - g.x));
-            const int ey = int(std::min<uint32_t>(2, dims_.y - g.y));
-            const int ez = int(std::min<uint32_t>(2, dims_.z - g.z));
-            T lo = L[bz][by][bx], hi = lo;
-            for (int z = 0; z < ez; ++z)
-                for (int y = 0; y < ey; ++y)
-                    for (int x = 0; x < ex; ++x) {
-                        const T v = L[bz + z][by + y][bx + x];
-                        lo = std::min(lo, v);
-                        hi = std::max(hi, v);
-                    }
-            T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
-            if (dims_.x - g.x >= 2 && dims_.y - g.y >= 2 && dims_.z - g.z >= 2) {
-                const int cx = int(std::min<uint32_t>(3, dims_.x - g.x));
-                const int cy = int(std::min<uint32_t>(3, dims_.y - g.y));
-                const int cz = int(std::min<uint32_t>(3, dims_.z - g.z));
-                for (int z = 0; z < cz; ++z)
-                    for (int y = 0; y < cy; ++y)
-                        for (int x = 0; x < cx; ++x) {
-                            const T v = L[bz + z][by + y][bx + x];
-                            cmin = std::min(cmin, v);
-                            cmax = std::max(cmax, v);
-                        }
-                widen(cmin, cmax);
-            }
-            T rep;
-            if (mergeable(lo, hi, rep)) {
-                ch[c] = {rep, cmin, cmax, lo, hi, true, false};
-                continue;
-            }
-            Cap<T> cap;
-            for (int k = 0; k < 8; ++k) cap.voxel[k] = L[bz + (k & 1)][by + ((k >> 1) & 1)][bx + ((k >> 2) & 1)];
-            sink.caps.push_back(cap);
-            ch[c] = {midpoint(lo, hi), cmin, cmax, lo, hi, false, false};
-        }
+        detail::cap_parent_children(
+            L, o, dims_, [this](T lo, T hi, T& rep) { return mergeable(lo, hi, rep); },
+            [this](T& lo, T& hi) { widen(lo, hi); }, [&](const Cap<T>& cap) { sink.caps.push_back(cap); }, ch);
         return combine(dmax_ - 2, ch, start, sink);
     }
 

@@ -5,6 +5,7 @@
 // voxels miss every blob support is uniform, so it is a leaf without descending; its cell range
 // is the background plus the blob values on its forward layer, enumerated from the supports.
 #include "octree/sparse_synthetic.h"
+#include "octree/summary.h"
 
 #include <algorithm>
 #include <bit>
@@ -79,13 +80,7 @@ uint32_t parse_sparse_spheres(std::string_view text, const std::string& flag) {
 namespace {
 
 /// What a finished subtree tells its parent (the same fields as build.cpp's Summary).
-template <typename T> struct Summary {
-    T scalar;
-    T cell_min, cell_max;   ///< empty: min > max
-    T data_lo, data_hi;
-    bool is_leaf;
-    bool is_padding;
-};
+using detail::Summary;
 
 template <typename T> class SparseBuilder {
 public:
@@ -129,13 +124,13 @@ private:
 
     uint32_t child_bit(int d) const { return 1u << (dmax_ - d - 1); }
     bool outside(Coord o) const { return o.x >= dims_.x || o.y >= dims_.y || o.z >= dims_.z; }
-    static Coord child_origin(Coord o, int c, uint32_t half) {
-        return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
+    static Coord child_origin(Coord o, int c, uint32_t half) { return detail::child_origin(o, c, half); }
+    static Summary<T> padding() { return Summary<T>::padding(); }
+    /// Lossless: only identical values merge (build_octree with tolerance 0).
+    static bool mergeable(T lo, T hi, T& rep) {
+        rep = lo;
+        return lo == hi;
     }
-    static Summary<T> padding() {
-        return {T{}, std::numeric_limits<T>::max(), std::numeric_limits<T>::lowest(), T{}, T{}, true, true};
-    }
-    static T midpoint(T lo, T hi) { return T(double(lo) + (double(hi) - double(lo)) / 2); }
 
     /// The node's data voxels [o, o + side) clipped to the data.
     Box voxel_box(Coord o, uint64_t side) const {
@@ -192,43 +187,17 @@ private:
         return combine(d, ch, start);
     }
 
-    // The two functions below repeat build.cpp's Builder::combine and build_cap_parent rules for
-    // tolerance 0 (the tests compare the arrays with build_octree's, node for node).
+    // The same rules as build_octree with tolerance 0 (summary.h); the tests compare the arrays
+    // node for node.
     Summary<T> combine(int d, const Summary<T>* ch, uint64_t start) {
-        bool all_leaves = true, any_data = false;
-        T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
-        T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
-        for (int c = 0; c < 8; ++c) {
-            all_leaves &= ch[c].is_leaf;
-            if (!ch[c].is_padding) {
-                any_data = true;
-                lo = std::min(lo, ch[c].data_lo);
-                hi = std::max(hi, ch[c].data_hi);
-            }
-            if (ch[c].cell_min <= ch[c].cell_max) {
-                cmin = std::min(cmin, ch[c].cell_min);
-                cmax = std::max(cmax, ch[c].cell_max);
-            }
-        }
-        if (d > 0 && all_leaves) {
-            if (!any_data) return padding();
-            if (lo == hi) return {lo, cmin, cmax, lo, hi, true, false};
-        }
         if (start > std::numeric_limits<uint32_t>::max())
             throw Error("sparse-spheres", "octree too large: more than 2^32 nodes at depth " + std::to_string(d + 1));
-        InteriorNode<T> n{};
-        uint8_t mask = 0;
-        for (int c = 0; c < 8; ++c) {
-            n.scalar[c] = ch[c].scalar;
-            n.min[c] = ch[c].cell_min;
-            n.max[c] = ch[c].cell_max;
-            if (!ch[c].is_leaf) mask = uint8_t(mask | (1u << c));
-        }
-        n.child_mask = mask;
-        n.child_start = uint32_t(start);
+        Summary<T> out;
+        InteriorNode<T> n;
+        if (detail::fold_children(d, ch, start, &SparseBuilder::mergeable, out, n)) return out;
         nodes_[size_t(d)].push_back(n);
-        leaves_[size_t(d)] += uint64_t(8 - std::popcount(unsigned(mask)));
-        return {any_data ? midpoint(lo, hi) : T{}, cmin, cmax, lo, hi, false, !any_data};
+        leaves_[size_t(d)] += uint64_t(8 - std::popcount(unsigned(n.child_mask)));
+        return out;
     }
 
     Summary<T> build_cap_parent(Coord o) {
@@ -242,44 +211,10 @@ private:
         for (int z = 0; z < 5; ++z)
             for (int y = 0; y < 5; ++y)
                 for (int x = 0; x < 5; ++x) L[z][y][x] = f_.value<T>(xs[x], ys[y], zs[z]);
-
         Summary<T> ch[8];
         const uint64_t start = caps_.size();
-        for (int c = 0; c < 8; ++c) {
-            const int bx = (c & 4) ? 2 : 0, by = (c & 2) ? 2 : 0, bz = (c & 1) ? 2 : 0;
-            const Coord g{o.x + uint32_t(bx), o.y + uint32_t(by), o.z + uint32_t(bz)};
-            if (outside(g)) { ch[c] = padding(); continue; }
-            const int ex = int(std::min<uint32_t>(2, dims_.x - g.x));
-            const int ey = int(std::min<uint32_t>(2, dims_.y - g.y));
-            const int ez = int(std::min<uint32_t>(2, dims_.z - g.z));
-            T lo = L[bz][by][bx], hi = lo;
-            for (int z = 0; z < ez; ++z)
-                for (int y = 0; y < ey; ++y)
-                    for (int x = 0; x < ex; ++x) {
-                        lo = std::min(lo, L[bz + z][by + y][bx + x]);
-                        hi = std::max(hi, L[bz + z][by + y][bx + x]);
-                    }
-            T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
-            if (dims_.x - g.x >= 2 && dims_.y - g.y >= 2 && dims_.z - g.z >= 2) {
-                const int cx = int(std::min<uint32_t>(3, dims_.x - g.x));
-                const int cy = int(std::min<uint32_t>(3, dims_.y - g.y));
-                const int cz = int(std::min<uint32_t>(3, dims_.z - g.z));
-                for (int z = 0; z < cz; ++z)
-                    for (int y = 0; y < cy; ++y)
-                        for (int x = 0; x < cx; ++x) {
-                            cmin = std::min(cmin, L[bz + z][by + y][bx + x]);
-                            cmax = std::max(cmax, L[bz + z][by + y][bx + x]);
-                        }
-            }
-            if (lo == hi) {
-                ch[c] = {lo, cmin, cmax, lo, hi, true, false};
-                continue;
-            }
-            Cap<T> cap;
-            for (int k = 0; k < 8; ++k) cap.voxel[k] = L[bz + (k & 1)][by + ((k >> 1) & 1)][bx + ((k >> 2) & 1)];
-            caps_.push_back(cap);
-            ch[c] = {midpoint(lo, hi), cmin, cmax, lo, hi, false, false};
-        }
+        detail::cap_parent_children(
+            L, o, dims_, &SparseBuilder::mergeable, [](T&, T&) {}, [&](const Cap<T>& cap) { caps_.push_back(cap); }, ch);
         return combine(dmax_ - 2, ch, start);
     }
 

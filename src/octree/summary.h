@@ -1,0 +1,133 @@
+// The bottom-up rules both octree builders share (build.cpp from a dense array, sparse_synthetic.cpp
+// from an analytic field): what a finished subtree tells its parent (Summary), how 8 children fold
+// into a scalar leaf or a stored InteriorNode, and how a depth dmax-2 node's 8 blocks of 2^3 become
+// leaves or caps from its 5^3 voxel neighbourhood (Knoll et al. 2006, Sec. 3.3, 4.1).
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <limits>
+
+#include "octiso/octree.h"
+
+namespace octiso::detail {
+
+/// What a finished subtree tells its parent.
+template <typename T> struct Summary {
+    T scalar;              ///< the value of a leaf; the midpoint of the data range otherwise
+    T cell_min, cell_max;  ///< range over the data cells with lower corner inside; empty: min > max
+    T data_lo, data_hi;    ///< range of the data voxels inside (meaningless when is_padding)
+    bool is_leaf;
+    bool is_padding;       ///< no data voxel inside at all
+
+    static Summary padding() {
+        return {T{}, std::numeric_limits<T>::max(), std::numeric_limits<T>::lowest(), T{}, T{}, true, true};
+    }
+};
+
+template <typename T> T midpoint(T lo, T hi) { return T(double(lo) + (double(hi) - double(lo)) / 2); }
+
+inline Coord child_origin(Coord o, int c, uint32_t half) {
+    return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
+}
+
+/// Folds the 8 child summaries of a node at depth d. Returns true with `out` = the merged scalar
+/// leaf when all children are leaves whose data ranges `mergeable(lo, hi, rep)` accepts (never at
+/// d == 0: the root is always stored). Otherwise fills `node` (child_start = `start`, local to the
+/// caller's arrays) and `out` with the stored node's summary, and returns false.
+template <typename T, class Mergeable>
+bool fold_children(int d, const Summary<T>* ch, uint64_t start, const Mergeable& mergeable, Summary<T>& out,
+                   InteriorNode<T>& node) {
+    bool all_leaves = true, any_data = false;
+    T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
+    T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
+    for (int c = 0; c < 8; ++c) {
+        all_leaves &= ch[c].is_leaf;
+        if (!ch[c].is_padding) {
+            any_data = true;
+            lo = std::min(lo, ch[c].data_lo);
+            hi = std::max(hi, ch[c].data_hi);
+        }
+        if (ch[c].cell_min <= ch[c].cell_max) {
+            cmin = std::min(cmin, ch[c].cell_min);
+            cmax = std::max(cmax, ch[c].cell_max);
+        }
+    }
+    if (d > 0 && all_leaves) {
+        if (!any_data) {
+            out = Summary<T>::padding();
+            return true;
+        }
+        T rep;
+        if (mergeable(lo, hi, rep)) {
+            out = {rep, cmin, cmax, lo, hi, true, false};
+            return true;
+        }
+    }
+    node = InteriorNode<T>{};
+    uint8_t mask = 0;
+    for (int c = 0; c < 8; ++c) {
+        node.scalar[c] = ch[c].scalar;
+        node.min[c] = ch[c].cell_min;
+        node.max[c] = ch[c].cell_max;
+        if (!ch[c].is_leaf) mask = uint8_t(mask | (1u << c));
+    }
+    node.child_mask = mask;
+    node.child_start = uint32_t(start);   // local; the caller offsets and range-checks it
+    out = {any_data ? midpoint(lo, hi) : T{}, cmin, cmax, lo, hi, false, !any_data};
+    return false;
+}
+
+/// The 8 children of a node at depth dmax-2 with origin o, from its 5^3 voxel neighbourhood L[z][y][x]
+/// (coordinates clamped into the data, so clamped slots replicate the border). Per block: the data
+/// range over its data voxels, the cell range over the 3^3 box clipped to the data (then
+/// `widen(lo, hi)`), a scalar leaf if `mergeable` accepts the data range, else a cap handed to
+/// `emit_cap`. Padding never enters a range.
+template <typename T, class Mergeable, class Widen, class EmitCap>
+void cap_parent_children(const T (&L)[5][5][5], Coord o, Dims dims, const Mergeable& mergeable, const Widen& widen,
+                         EmitCap&& emit_cap, Summary<T> (&ch)[8]) {
+    for (int c = 0; c < 8; ++c) {
+        const int bx = (c & 4) ? 2 : 0, by = (c & 2) ? 2 : 0, bz = (c & 1) ? 2 : 0;
+        const Coord g{o.x + uint32_t(bx), o.y + uint32_t(by), o.z + uint32_t(bz)};
+        if (g.x >= dims.x || g.y >= dims.y || g.z >= dims.z) {
+            ch[c] = Summary<T>::padding();
+            continue;
+        }
+        const int ex = int(std::min<uint32_t>(2, dims.x - g.x));
+        const int ey = int(std::min<uint32_t>(2, dims.y - g.y));
+        const int ez = int(std::min<uint32_t>(2, dims.z - g.z));
+        T lo = L[bz][by][bx], hi = lo;
+        for (int z = 0; z < ez; ++z)
+            for (int y = 0; y < ey; ++y)
+                for (int x = 0; x < ex; ++x) {
+                    const T v = L[bz + z][by + y][bx + x];
+                    lo = std::min(lo, v);
+                    hi = std::max(hi, v);
+                }
+        T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
+        if (dims.x - g.x >= 2 && dims.y - g.y >= 2 && dims.z - g.z >= 2) {
+            const int cx = int(std::min<uint32_t>(3, dims.x - g.x));
+            const int cy = int(std::min<uint32_t>(3, dims.y - g.y));
+            const int cz = int(std::min<uint32_t>(3, dims.z - g.z));
+            for (int z = 0; z < cz; ++z)
+                for (int y = 0; y < cy; ++y)
+                    for (int x = 0; x < cx; ++x) {
+                        const T v = L[bz + z][by + y][bx + x];
+                        cmin = std::min(cmin, v);
+                        cmax = std::max(cmax, v);
+                    }
+            widen(cmin, cmax);
+        }
+        T rep;
+        if (mergeable(lo, hi, rep)) {
+            ch[c] = {rep, cmin, cmax, lo, hi, true, false};
+            continue;
+        }
+        Cap<T> cap;
+        for (int k = 0; k < 8; ++k) cap.voxel[k] = L[bz + (k & 1)][by + ((k >> 1) & 1)][bx + ((k >> 2) & 1)];
+        emit_cap(cap);
+        ch[c] = {midpoint(lo, hi), cmin, cmax, lo, hi, false, false};
+    }
+}
+
+}  // namespace octiso::detail
