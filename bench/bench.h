@@ -48,6 +48,14 @@ uint64_t current_rss_bytes();   ///< /proc/self/statm resident pages
 /// Median wall seconds of `repeats` calls of fn (after one warm-up call).
 double median_seconds(int repeats, const std::function<void()>& fn);
 
+/// CPU seconds of the calling thread: a one-thread frame timed this way does not count the time
+/// the scheduler gives other processes on a shared machine.
+double thread_cpu_seconds();
+/// The isovalue every benchmark uses for a dataset unless --iso says otherwise: half-integers on
+/// u8 data, so no voxel lies exactly on the surface and no method is judged on a tie.
+/// plume 40.5, mixing 127.5, sphere 20.5, anything else (ch2 MRI: the white/grey matter boundary) 80.5.
+double default_isovalue(const std::string& dataset);
+
 /// Machine line for the reports: CPU model, cores, compiler.
 std::string machine_description();
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -128,6 +129,19 @@ double median_seconds(int repeats, const std::function<void()>& fn) {
     }
     std::sort(t.begin(), t.end());
     return t[t.size() / 2];
+}
+
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+double default_isovalue(const std::string& dataset) {
+    if (dataset == "plume") return 40.5;
+    if (dataset == "mixing") return 127.5;
+    if (dataset == "sphere") return 20.5;
+    return 80.5;
 }
 
 std::string machine_description() {

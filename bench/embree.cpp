@@ -29,21 +29,6 @@ const char* const kEmbreeUsage =
     "  NAME: plume, mixing (synthetic N^3, default 256), mri, sphere (mostly empty space: dispatch-bound)\n"
     "  --threads default 1 (least noise on a shared machine; the cost is per ray); --quick: 128^3, 256x256";
 
-double embree_default_iso(const std::string& dataset) {   // same as `octiso-bench peers`
-    if (dataset == "plume") return 40.5;
-    if (dataset == "mixing") return 127.5;
-    if (dataset == "sphere") return 20.5;
-    return 80.5;
-}
-
-/// CPU seconds of the calling thread: with one thread the frame runs on it alone, and time the
-/// scheduler gives to other processes on this shared machine does not count.
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
 /// The Embree path as a tracer for trace_frame: the same scene->intersect call render() makes.
 struct EmbreeTracer {
     const EmbreeVolumeScene* scene;
@@ -102,7 +87,7 @@ int run_embree(cli::Args& args) {
         EmbreeRow row;
         row.name = name;
         row.dims = volume.dims();
-        row.iso = iso_flag ? cli::parse_double(*iso_flag, "--iso") : embree_default_iso(name);
+        row.iso = iso_flag ? cli::parse_double(*iso_flag, "--iso") : default_isovalue(name);
         const Camera camera = frame_data_box(volume.dims(), volume.placement(), wh[0], wh[1]);
         std::cerr << "embree: " << name << ", iso " << row.iso << "\n";
         dispatch_scalar_type(volume.type(), [&](auto tag) {

@@ -32,20 +32,6 @@ const char* const kGridUsage =
     "  --threads 1 times each frame in thread CPU seconds (robust on a busy machine); else wall seconds\n"
     "  --image default 512x512; --quick: 128^3, 256x256, 2 repeats";
 
-double grid_default_iso(const std::string& dataset) {   // same as `octiso-bench peers`
-    if (dataset == "plume") return 40.5;
-    if (dataset == "mixing") return 127.5;
-    return 80.5;
-}
-
-/// CPU seconds of the calling thread. With --threads 1 the whole frame runs on it, and time the
-/// scheduler gives to other processes on a shared machine does not count.
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
 struct VariantResult {
     std::string structure, data, config;
     std::vector<double> seconds;
@@ -205,7 +191,7 @@ int run_grid(cli::Args& args) {
             run.source = volume.source();
             run.type = std::string(scalar_type_name(volume.type()));
             run.dims = volume.dims();
-            run.iso = iso_flag ? cli::parse_double(*iso_flag, "--iso") : grid_default_iso(name);
+            run.iso = iso_flag ? cli::parse_double(*iso_flag, "--iso") : default_isovalue(name);
             const Camera camera = frame_data_box(volume.dims(), volume.placement(), wh[0], wh[1]);
             std::cerr << "grid: " << name << " " << run.dims.x << "x" << run.dims.y << "x" << run.dims.z << " " << run.type
                       << ", iso " << run.iso << ", " << wh[0] << "x" << wh[1] << "\n";

@@ -41,12 +41,6 @@ const char* kUsage =
 
 /// Default isovalues: half-integers, so no voxel of these integer-valued data sets lies exactly on
 /// the surface and no method is judged on a tie.
-double default_iso(const std::string& dataset) {
-    if (dataset == "plume") return 40.5;
-    if (dataset == "mixing") return 127.5;
-    return 80.5;   // ch2: white/grey matter boundary region of the MNI template
-}
-
 struct OctisoResult {
     double build_seconds = 0;          ///< one-off conversion (not per isovalue)
     uint64_t file_bytes = 0;
@@ -379,7 +373,7 @@ int run_peers(cli::Args& args) {
     std::vector<DatasetResult> results;
     for (const std::string& name : names) {
         LoadedVolume volume = open_dataset(name, n, mri);
-        const double iso = iso_text ? cli::parse_double(*iso_text, "--iso") : default_iso(name);
+        const double iso = iso_text ? cli::parse_double(*iso_text, "--iso") : default_isovalue(name);
         const Camera camera = frame_data_box(volume.dims(), volume.placement(), image[0], image[1]);
         results.push_back(run_dataset(name, volume, iso, camera, repeats, threads, qualities, normals == "vertex"));
         print_dataset(results.back(), markdown);

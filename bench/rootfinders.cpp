@@ -107,14 +107,6 @@ double angle_deg(const std::array<double, 3>& a, const std::array<double, 3>& b)
     return std::acos(d) * 180.0 / M_PI;
 }
 
-/// CPU seconds of the calling thread: on a shared machine, time given to other processes does not
-/// count (the solves run on one thread).
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
 /// Errors of `cfg` on `calls` given the exact roots `s_ref`, then the timing: the stream is
 /// solved repeatedly until `min_solves` calls, the sum of the results is consumed, median of
 /// `timing_repeats` runs, in thread CPU time.

@@ -30,12 +30,6 @@ const char* const kScalingUsage =
     "  NAME: plume (default), mixing (synthetic N^3, default 256) or mri\n"
     "  --quick: 128^3, images 256 and 512, 2 repeats";
 
-double scaling_default_iso(const std::string& dataset) {   // same as `octiso-bench peers`
-    if (dataset == "plume") return 40.5;
-    if (dataset == "mixing") return 127.5;
-    return 80.5;
-}
-
 /// Tiles of blocked_range2d(0, H, ts, 0, W, ts) in the order TBB's simple_partitioner produces them
 /// when run serially: split the side that is longer relative to its grain size, at the middle,
 /// left half first (oneTBB blocked_range2d::do_split), until neither side exceeds the grain.
@@ -190,7 +184,7 @@ int run_scaling(cli::Args& args) {
     if (name == "plume" || name == "mixing") volume = synthetic_step(name, Dims{n, n, n}, 0);
     else if (name == "mri") volume = open_volume(mri_flag ? *mri_flag : "/usr/share/mricron/templates/ch2.nii.gz", RawOptions{});
     else throw Error("--dataset", "expected plume, mixing or mri, found '" + name + "'");
-    const double iso = iso_flag ? cli::parse_double(*iso_flag, "--iso") : scaling_default_iso(name);
+    const double iso = iso_flag ? cli::parse_double(*iso_flag, "--iso") : default_isovalue(name);
     const Dims dims = volume.dims();
     std::cerr << "scaling: " << name << " " << dims.x << "x" << dims.y << "x" << dims.z << ", iso " << iso << "\n";
 
