@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "octiso/image.h"
+#include "test_util/scratch_dir.h"
 
 namespace octiso::test {
 namespace {
@@ -18,19 +19,8 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kTools = OCTISO_TOOLS_DIR;
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        static int n = 0;
-        path = fs::temp_directory_path() / ("octiso_render_cli_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-    size_t entries() const { return size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator())); }
+struct TempDir : ScratchDir {
+    TempDir() : ScratchDir("octiso_render_cli") {}
 };
 
 int run(const std::string& tool, const std::string& args, std::string* out = nullptr, std::string* err = nullptr) {

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <limits>
 
+#include "test_util/scratch_dir.h"
 #include "octiso/build.h"
 #include "octiso/decode.h"
 #include "octiso/error.h"
@@ -112,19 +113,8 @@ int run(const std::string& cmd, std::string* out = nullptr) {
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-struct Dir {
-    fs::path path;
-    Dir() {
-        static int n = 0;
-        path = fs::temp_directory_path() / ("octiso_extreme_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-        fs::create_directories(path);
-    }
-    ~Dir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-    size_t entries() const { return size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator())); }
+struct Dir : ScratchDir {
+    Dir() : ScratchDir("octiso_extreme") {}
 };
 
 template <typename T> void write_raw(const std::string& path, const std::vector<T>& v) {

@@ -16,6 +16,7 @@
 #include "octiso/decode.h"
 #include "octiso/oct_file.h"
 #include "octiso/synthetic.h"
+#include "test_util/scratch_dir.h"
 
 namespace octiso::test {
 namespace {
@@ -23,20 +24,8 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kConvert = std::string(OCTISO_TOOLS_DIR) + "/octiso-convert";
 
-struct CliDir {
-    fs::path path;
-    CliDir() {
-        static int n = 0;
-        path = fs::temp_directory_path() / ("octiso_convert_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-        fs::create_directories(path);
-    }
-    ~CliDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-    /// Nothing but the given inputs: no output, no ".tmp-*" leftovers.
-    size_t entries() const { return size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator())); }
+struct CliDir : ScratchDir {
+    CliDir() : ScratchDir("octiso_convert") {}
 };
 
 /// Exit status of `args` run through the shell with stdout captured; stderr is discarded.

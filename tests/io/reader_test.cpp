@@ -18,6 +18,7 @@
 #include <sstream>
 #include <vector>
 
+#include "test_util/scratch_dir.h"
 #include "octiso/error.h"
 #include "octiso/reader.h"
 
@@ -26,22 +27,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() / ("octiso_reader_" + std::to_string(::getpid()) + "_" +
-                                            std::to_string(counter()++));
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-    static int& counter() {
-        static int n = 0;
-        return n;
-    }
+struct TempDir : ScratchDir {
+    TempDir() : ScratchDir("octiso_reader") {}
 };
 
 void write_bytes(const std::string& path, const std::string& bytes) {
@@ -152,7 +139,7 @@ TEST(RawReader, MalformedInputsNameTheFile) {
     write_bytes(empty, "");
     expect_error([&] { read_raw(empty, {1, 1, 1}, ScalarType::u8); }, empty);
     expect_error([&] { read_raw(dir.file("missing.raw"), {1, 1, 1}, ScalarType::u8); }, "missing.raw");
-    expect_error([&] { read_raw(dir.path.string(), {1, 1, 1}, ScalarType::u8); }, dir.path.string());
+    expect_error([&] { read_raw(dir.path().string(), {1, 1, 1}, ScalarType::u8); }, dir.path().string());
 }
 
 // ---- open_volume: format choice and flags --------------------------------------------------
