@@ -97,7 +97,6 @@ template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& inpu
                     out.storage[i] = std::isfinite(v) ? v : replacement;
                 }
             });
-            for (uint64_t i = 0; i < n; ++i) out.replaced_voxels += !std::isfinite(input.load(i));
             out.view = VolumeView<T>{reinterpret_cast<const std::byte*>(out.storage.data()), input.dims, false};
         }
     }
@@ -125,21 +124,16 @@ template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& inpu
 
     const T lo_t = clamp_target_low<T>(lo), hi_t = clamp_target_high<T>(hi);
     std::vector<T> clamped(n);
-    const uint64_t changed = tbb::parallel_reduce(
-        tbb::blocked_range<uint64_t>(0, n, 1 << 16), uint64_t(0),
-        [&](const tbb::blocked_range<uint64_t>& r, uint64_t count) {
-            for (uint64_t i = r.begin(); i < r.end(); ++i) {
-                T v = src.load(i);
-                if ((flags[i] & kAtOrBelowLo) && v < lo_t) v = lo_t, ++count;
-                else if ((flags[i] & kAtOrAboveHi) && v > hi_t) v = hi_t, ++count;
-                clamped[i] = v;
-            }
-            return count;
-        },
-        [](uint64_t a, uint64_t b) { return a + b; });
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 1 << 16), [&](const tbb::blocked_range<uint64_t>& r) {
+        for (uint64_t i = r.begin(); i < r.end(); ++i) {
+            T v = src.load(i);
+            if ((flags[i] & kAtOrBelowLo) && v < lo_t) v = lo_t;
+            else if ((flags[i] & kAtOrAboveHi) && v > hi_t) v = hi_t;
+            clamped[i] = v;
+        }
+    });
     flags = {};
     out.storage = std::move(clamped);
-    out.clamped_voxels = changed;
     out.view = VolumeView<T>{reinterpret_cast<const std::byte*>(out.storage.data()), d, false};
     return out;
 }

@@ -12,8 +12,6 @@ namespace octiso::detail {
 template <typename T> struct PreparedVolume {
     VolumeView<T> view;      ///< what the builder reads: the input, or `storage`
     std::vector<T> storage;  ///< the modified copy, empty when the input is used as is
-    uint64_t clamped_voxels = 0;
-    uint64_t replaced_voxels = 0;
 };
 
 template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& input, const BuildOptions& options);
