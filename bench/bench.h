@@ -12,6 +12,7 @@
 
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
+#include "util/process_memory.h"   // peak_rss_bytes, current_rss_bytes, mapped_resident_bytes
 
 namespace octiso::bench {
 
@@ -43,8 +44,6 @@ std::string write_json(const std::string& dir, const std::string& name, const st
 bool plot(const std::string& kind, const std::string& json_path, const std::string& png_path);
 
 double seconds_since(std::chrono::steady_clock::time_point t0);
-uint64_t peak_rss_bytes();      ///< getrusage ru_maxrss
-uint64_t current_rss_bytes();   ///< /proc/self/statm resident pages
 /// Median wall seconds of `repeats` calls of fn (after one warm-up call).
 double median_seconds(int repeats, const std::function<void()>& fn);
 

@@ -1,5 +1,4 @@
 // octiso-bench SUBCOMMAND [flags]: scaling and comparison benchmarks, one file per question.
-#include <sys/resource.h>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -104,19 +103,6 @@ bool plot(const std::string& kind, const std::string& json_path, const std::stri
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-uint64_t peak_rss_bytes() {
-    rusage ru{};
-    getrusage(RUSAGE_SELF, &ru);
-    return uint64_t(ru.ru_maxrss) * 1024;
-}
-
-uint64_t current_rss_bytes() {
-    std::ifstream statm("/proc/self/statm");
-    uint64_t size = 0, resident = 0;
-    statm >> size >> resident;
-    return resident * uint64_t(::sysconf(_SC_PAGESIZE));
 }
 
 double median_seconds(int repeats, const std::function<void()>& fn) {

@@ -29,28 +29,6 @@ constexpr const char* kUsage =
     "                           [--rss-steps 100] [--rss-size N] [--no-rss] [--keep DIR] [--results DIR]\n"
     "  default: --size 128 --steps 32 (quick); the paper's case is --size 302 --steps 153";
 
-/// Resident bytes of every mapping of `path` in this process (/proc/self/smaps), i.e. the part
-/// of the mmap'd file this process has touched (plus the kernel's fault-around of up to 64 KiB).
-uint64_t mapped_resident_bytes(const std::string& path) {
-    const std::string want = fs::canonical(path).string();
-    std::ifstream smaps("/proc/self/smaps");
-    std::string line;
-    bool inside = false;
-    uint64_t total = 0;
-    while (std::getline(smaps, line)) {
-        // A mapping header reads "start-end perms offset dev inode [path]"; fields follow it.
-        const size_t dash = line.find('-');
-        if (dash != std::string::npos && dash > 0 && std::isxdigit(static_cast<unsigned char>(line[0])) &&
-            line.find(' ') > dash) {
-            const size_t slash = line.find('/');
-            inside = slash != std::string::npos && line.compare(slash, std::string::npos, want) == 0;
-        } else if (inside && line.rfind("Rss:", 0) == 0) {
-            total += std::stoull(line.substr(4)) * 1024;
-        }
-    }
-    return total;
-}
-
 std::string mib(uint64_t b) { return fmt(double(b) / (1024.0 * 1024.0), 2); }
 
 struct StepRow {

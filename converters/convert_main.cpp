@@ -6,7 +6,6 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
-#include <sys/resource.h>
 #include <sys/stat.h>
 
 #include <tbb/global_control.h>
@@ -19,6 +18,7 @@
 #include "octiso/reader.h"
 #include "octiso/synthetic.h"
 #include "octree/sparse_synthetic.h"
+#include "util/process_memory.h"
 
 namespace {
 
@@ -341,9 +341,7 @@ int convert(std::vector<std::string>& argv) {
 
     struct stat st {};
     const uint64_t file_bytes = ::stat(out->c_str(), &st) == 0 ? uint64_t(st.st_size) : writer.bytes_written();
-    struct rusage ru {};
-    ::getrusage(RUSAGE_SELF, &ru);
-    const uint64_t peak_rss = uint64_t(ru.ru_maxrss) * 1024;
+    const uint64_t peak_rss = peak_rss_bytes();
     const double total_seconds = seconds_since(t_start);
     write_human(std::cerr, src, first, *out, n_steps, file_bytes, tot, total_seconds, peak_rss, threads);
     if (json) write_json(std::cout, src, first, *out, n_steps, file_bytes, tot, total_seconds, peak_rss, threads, opt);

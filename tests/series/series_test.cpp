@@ -18,6 +18,7 @@
 #include "octiso/oct_file.h"
 #include "octiso/render.h"
 #include "octiso/synthetic.h"
+#include "util/process_memory.h"
 
 namespace octiso::test {
 namespace {
@@ -45,25 +46,6 @@ void write_mhd(const std::string& path, Dims d, const char* element_type, const 
 
 bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
-
-/// Resident bytes of this process's mappings of `path` (/proc/self/smaps).
-uint64_t mapped_resident_bytes(const std::string& path) {
-    const std::string want = fs::canonical(path).string();
-    std::ifstream smaps("/proc/self/smaps");
-    std::string line;
-    bool inside = false;
-    uint64_t total = 0;
-    while (std::getline(smaps, line)) {
-        const size_t dash = line.find('-'), space = line.find(' ');
-        if (dash != std::string::npos && dash > 0 && space > dash && std::isxdigit(static_cast<unsigned char>(line[0]))) {
-            const size_t slash = line.find('/');
-            inside = slash != std::string::npos && line.compare(slash, std::string::npos, want) == 0;
-        } else if (inside && line.rfind("Rss:", 0) == 0) {
-            total += std::stoull(line.substr(4)) * 1024;
-        }
-    }
-    return total;
 }
 
 class SeriesCli : public ::testing::Test {
