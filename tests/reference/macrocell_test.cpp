@@ -11,75 +11,15 @@
 #include "reference/macrocell.h"
 #include "reference/trace_frame.h"
 #include "render/camera.h"
+#include "render/render_test_util.h"
 
 namespace octiso::test {
 namespace {
 
-enum class Field { Sphere, MarschnerLobb, Noise };
-
-/// Values in [0, 120], rounded for integer types (so every type holds them).
-template <typename T> DenseVolume<T> make_field(Field field, Dims dims) {
-    DenseVolume<T> v{dims, std::vector<T>(dims.voxels())};
-    std::mt19937 rng(7);
-    std::vector<double> lattice(509);
-    for (double& x : lattice) x = std::uniform_real_distribution<double>(0, 120)(rng);
-    for (uint32_t z = 0; z < dims.z; ++z)
-        for (uint32_t y = 0; y < dims.y; ++y)
-            for (uint32_t x = 0; x < dims.x; ++x) {
-                const double u = (x + 0.5) / dims.x * 2 - 1, w = (y + 0.5) / dims.y * 2 - 1, q = (z + 0.5) / dims.z * 2 - 1;
-                double f = 0;
-                if (field == Field::Sphere) {
-                    f = 120 * (1 - std::sqrt(u * u + w * w + q * q) / std::sqrt(3.0));
-                } else if (field == Field::MarschnerLobb) {
-                    const double rho = std::cos(2 * M_PI * 6 * std::cos(M_PI * std::sqrt(u * u + w * w) / 2));
-                    f = 120 * (1 - std::sin(M_PI * q / 2) + 0.25 * (1 + rho)) / 2.5;
-                } else {
-                    f = lattice[(x * 73856093u ^ y * 19349663u ^ z * 83492791u) % 509];
-                }
-                if constexpr (!std::is_floating_point_v<T>) f = std::round(f);
-                v.values[x + uint64_t(dims.x) * (y + uint64_t(dims.y) * z)] = T(f);
-            }
-    return v;
-}
-
-Camera look_at(std::array<double, 3> eye, std::array<double, 3> look, std::array<double, 3> up, double fov, int size) {
-    Camera c;
-    c.eye = eye, c.look = look, c.up = up, c.fov_deg = fov, c.width = c.height = size;
-    return c;
-}
-
-struct Agreement {
-    uint64_t pixels = 0, mask_mismatch = 0;
-    std::vector<double> depth_err;   // voxel units
-    double p99() {
-        if (depth_err.empty()) return 0;
-        std::sort(depth_err.begin(), depth_err.end());
-        return depth_err[std::min(depth_err.size() - 1, size_t(0.99 * double(depth_err.size())))];
-    }
-};
-
 template <typename T>
-Agreement against_reference(const Frame& frame, const DenseVolume<T>& v, const Placement& placement, const Camera& camera,
-                            double iso) {
-    const PinholeCamera pinhole(camera);
-    const double voxel = std::min({placement.spacing[0], placement.spacing[1], placement.spacing[2]});
-    Agreement a;
-    for (int py = 0; py < camera.height; ++py)
-        for (int px = 0; px < camera.width; ++px) {
-            const RefHit ref = trace_reference(v.view(), placement, pinhole.ray(px, py), iso);
-            const float t = frame.depth[size_t(py) * camera.width + px];
-            ++a.pixels;
-            if (std::isfinite(t) != ref.is_hit()) ++a.mask_mismatch;
-            else if (ref.is_hit()) a.depth_err.push_back(std::abs(double(t) - ref.t) / voxel);
-        }
-    return a;
-}
-
-void expect_agreement(Agreement a, const std::string& what) {
-    SCOPED_TRACE(what);
-    EXPECT_LE(double(a.mask_mismatch), 0.0005 * double(a.pixels)) << a.mask_mismatch << " of " << a.pixels << " pixels differ";
-    EXPECT_LE(a.p99(), 1e-3) << "depth p99 in voxels";
-    EXPECT_GT(a.depth_err.size(), 0u) << "the view must actually show the surface";
+ImageError against_reference(const Frame& frame, const DenseVolume<T>& v, const Placement& placement, const Camera& camera,
+                             double iso) {
+    return error_against_reference(frame, v.view(), placement, camera, iso);
 }
 
 template <typename T>

@@ -6,71 +6,17 @@
 
 #include "octiso/build.h"
 #include "octiso/render.h"
-#include "octree/octree_test_util.h"
 #include "reference/brute_force.h"
 #include "render/camera.h"
+#include "render/render_test_util.h"
 
 namespace octiso::test {
 namespace {
 
-enum class Field { Sphere, MarschnerLobb, Noise, Sierpinski, Torus };
-
-/// Fields with values in [0, 120] (so every type, i8 included, holds them), rounded for integer types.
-template <typename T> DenseVolume<T> make_field(Field field, Dims dims, uint32_t seed = 1) {
-    DenseVolume<T> v{dims, std::vector<T>(dims.voxels())};
-    std::mt19937 rng(seed);
-    std::vector<double> lattice(512);
-    for (double& x : lattice) x = std::uniform_real_distribution<double>(0, 255)(rng);
-    for (uint32_t z = 0; z < dims.z; ++z)
-        for (uint32_t y = 0; y < dims.y; ++y)
-            for (uint32_t x = 0; x < dims.x; ++x) {
-                const double u = (x + 0.5) / dims.x * 2 - 1, w = (y + 0.5) / dims.y * 2 - 1, q = (z + 0.5) / dims.z * 2 - 1;
-                double f = 0;
-                switch (field) {
-                    case Field::Sphere: f = 255 * (1 - std::sqrt(u * u + w * w + q * q) / std::sqrt(3.0)); break;
-                    case Field::MarschnerLobb: {
-                        const double r = std::sqrt(u * u + w * w);
-                        const double rho = std::cos(2 * M_PI * 6 * std::cos(M_PI * r / 2));
-                        f = 255 * (1 - std::sin(M_PI * q / 2) + 0.25 * (1 + rho)) / (2 * 1.25);
-                        break;
-                    }
-                    case Field::Noise: f = lattice[(x * 73856093u ^ y * 19349663u ^ z * 83492791u) % 512]; break;
-                    case Field::Sierpinski: {
-                        uint32_t a = x, b = y, c = z;
-                        bool hole = false;
-                        while (a || b || c) {
-                            hole |= ((a % 3 == 1) + (b % 3 == 1) + (c % 3 == 1)) >= 2;
-                            a /= 3, b /= 3, c /= 3;
-                        }
-                        f = hole ? 0 : 255;
-                        break;
-                    }
-                    case Field::Torus: {
-                        const double ring = std::sqrt(u * u + w * w) - 0.55;
-                        f = 255 * std::clamp(1 - std::sqrt(ring * ring + q * q) / 0.6, 0.0, 1.0);
-                        break;
-                    }
-                }
-                f *= 120.0 / 255.0;
-                if constexpr (!std::is_floating_point_v<T>) f = std::round(f);
-                v.values[x + uint64_t(dims.x) * (y + uint64_t(dims.y) * z)] = T(f);
-            }
-    return v;
-}
-
-struct Agreement {
-    uint64_t pixels = 0, mask_mismatch = 0, both = 0;
-    std::vector<double> depth_err;   // voxel units
-    double p99() {
-        if (depth_err.empty()) return 0;
-        std::sort(depth_err.begin(), depth_err.end());
-        return depth_err[std::min(depth_err.size() - 1, size_t(0.99 * double(depth_err.size())))];
-    }
-};
-
+/// Builds the octree of `v`, renders its depth, and measures it against the exact reference.
 template <typename T>
-Agreement compare_with_reference(const DenseVolume<T>& v, const Placement& placement, const Camera& camera, double iso,
-                                 bool use_embree = false) {
+ImageError compare_with_reference(const DenseVolume<T>& v, const Placement& placement, const Camera& camera, double iso,
+                                  bool use_embree = false) {
     const auto data = build_octree(v.view(), {});
     RenderOptions options;
     options.isovalues = {iso};
@@ -78,34 +24,7 @@ Agreement compare_with_reference(const DenseVolume<T>& v, const Placement& place
     options.want_depth = true;
     options.use_embree = use_embree;
     const Frame frame = render(data.view(), placement, camera, options);
-    const PinholeCamera pinhole(camera);
-    const double voxel = std::min({placement.spacing[0], placement.spacing[1], placement.spacing[2]});
-    Agreement a;
-    for (int py = 0; py < camera.height; ++py)
-        for (int px = 0; px < camera.width; ++px) {
-            const RefHit ref = trace_reference(v.view(), placement, pinhole.ray(px, py), iso);
-            const float t = frame.depth[size_t(py) * camera.width + px];
-            const bool hit = std::isfinite(t);
-            ++a.pixels;
-            if (hit != ref.is_hit()) ++a.mask_mismatch;
-            else if (hit) a.depth_err.push_back(std::abs(double(t) - ref.t) / voxel);
-        }
-    a.both = a.depth_err.size();
-    return a;
-}
-
-Camera look_at(std::array<double, 3> eye, std::array<double, 3> look, std::array<double, 3> up, double fov, int size) {
-    Camera c;
-    c.eye = eye, c.look = look, c.up = up, c.fov_deg = fov, c.width = c.height = size;
-    return c;
-}
-
-void expect_agreement(Agreement a, const std::string& what) {
-    SCOPED_TRACE(what);
-    EXPECT_LE(double(a.mask_mismatch), 0.0005 * double(a.pixels)) << a.mask_mismatch << " of " << a.pixels << " pixels differ";
-    // float depth output: allow its own rounding (2^-24 relative) on top of 1e-3 voxel
-    EXPECT_LE(a.p99(), 1e-3) << "depth p99 in voxels";
-    EXPECT_GT(a.both, 0u) << "the view must actually show the surface";
+    return error_against_reference(frame, v.view(), placement, camera, iso);
 }
 
 template <typename T> class RenderAgreement : public ::testing::Test {};
@@ -146,10 +65,10 @@ TEST(RenderAgreementFields, NoiseSierpinskiTorusOddShapes) {
         const double r = 1.6 * std::max({c.dims.x, c.dims.y, c.dims.z});
         for (const auto& eye : {std::array<double, 3>{centre[0] + r, centre[1] - 0.7 * r, centre[2] + 0.5 * r},
                                 std::array<double, 3>{centre[0] - 0.3 * r, centre[1] + r, centre[2] - 0.8 * r}}) {
-            Agreement a = compare_with_reference(v, placement, look_at(eye, centre, {0, 0, 1}, 40, 48), c.iso);
+            const ImageError a = compare_with_reference(v, placement, look_at(eye, centre, {0, 0, 1}, 40, 48), c.iso);
             SCOPED_TRACE(::testing::Message() << "field " << int(c.field));
             EXPECT_LE(double(a.mask_mismatch), 0.0005 * double(a.pixels)) << a.mask_mismatch;
-            EXPECT_LE(a.p99(), 1e-3);
+            EXPECT_LE(a.depth_p99, 1e-3);
         }
     }
 }
@@ -172,10 +91,10 @@ TEST(RenderAgreementCameras, AxisAlignedInsideAndGrazing) {
         look_at({-30, -30, 0}, {30, 30, 0}, {0, 0, 1}, 25, 48)};
     int i = 0;
     for (const Camera& cam : cams) {
-        Agreement a = compare_with_reference(v, placement, cam, 42.0);
+        const ImageError a = compare_with_reference(v, placement, cam, 42.0);
         SCOPED_TRACE("camera " + std::to_string(i++));
         EXPECT_LE(double(a.mask_mismatch), 0.0005 * double(a.pixels)) << a.mask_mismatch << " of " << a.pixels;
-        EXPECT_LE(a.p99(), 1e-3);
+        EXPECT_LE(a.depth_p99, 1e-3);
     }
 }
 
