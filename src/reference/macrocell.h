@@ -131,24 +131,15 @@ template <typename T, class Finder, class Corners> class MacrocellTracer {
 public:
     MacrocellTracer(const MacrocellGrid<T>& grid, const Corners& corners, const Placement& placement,
                     const double* isovalues, int iso_count, const Finder& finder)
-        : grid_(grid), corners_(corners), placement_(placement), iso_count_(iso_count), finder_(finder) {
-        for (int i = 0; i < iso_count; ++i) iso_[i] = isovalues[i];
-        const Dims d = grid.dims();
-        box_hi_ = {double(d.x) - 1, double(d.y) - 1, double(d.z) - 1};
-        has_cells_ = d.x >= 2 && d.y >= 2 && d.z >= 2;
+        : grid_(grid), corners_(corners), scene_(grid.dims(), placement, isovalues, iso_count), finder_(finder) {
         int64_t s = 1;
         for (int l = 0; l <= grid.levels(); ++l, s *= grid.branching()) unit_[size_t(l)] = double(s);
     }
 
     TraceHit trace(const Ray& ray_world, bool want_normal) const {
         Walk w;
-        w.world_dir = ray_world.dir;
-        w.want_normal = want_normal;
-        if (!has_cells_) return w.hit;
-        w.ray = index_from_world(ray_world, placement_);
-        const BoxClip clip = clip_to_box(w.ray, box_hi_);
+        const BoxClip clip = w.start(scene_, ray_world, want_normal);
         if (clip.empty()) return w.hit;
-        w.t_exit = clip.t_out;
         const int top = grid_.levels();
         const int64_t lo[3] = {0, 0, 0};
         const auto& c = grid_.count(top);
@@ -158,19 +149,7 @@ public:
     }
 
 private:
-    struct Walk {
-        IndexRay ray;
-        std::array<double, 3> world_dir{};
-        double t_exit = 0;
-        bool want_normal = false;
-        TraceHit hit;
-    };
-
-    bool any_iso_in(double lo, double hi) const {
-        for (int i = 0; i < iso_count_; ++i)
-            if (lo <= iso_[i] && iso_[i] <= hi) return true;
-        return false;
-    }
+    using Walk = RayState;
 
     /// DDA over the level-l units [lo, hi) (per axis, hi exclusive) the ray crosses on [t0, t1),
     /// in order; a macrocell is entered when an isovalue lies in its range, a cell is solved.
@@ -212,7 +191,7 @@ private:
                     const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
                     corners_.gather(v, corner);
                     if (test_cell(w, v, corner, t_cur, t_out, closed_end)) return true;
-                } else if (any_iso_in(double(grid_.min_at(l, cell[0], cell[1], cell[2])),
+                } else if (scene_.any_iso_in(double(grid_.min_at(l, cell[0], cell[1], cell[2])),
                                       double(grid_.max_at(l, cell[0], cell[1], cell[2])))) {
                     const int64_t b = grid_.branching();
                     const auto& below = grid_.count(l - 1);
@@ -230,18 +209,13 @@ private:
     }
 
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
-        const CellQuery q{iso_, iso_count_, &w.ray, &placement_.spacing, &w.world_dir, w.want_normal};
-        return intersect_cell(finder_, q, v, corner, t_in, t_out, closed_end, w.hit);
+        return intersect_cell(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
     }
 
     const MacrocellGrid<T>& grid_;
     const Corners corners_;
-    const Placement placement_;
-    double iso_[kMaxIsovalues] = {};
-    int iso_count_;
+    const CellWalkScene scene_;
     const Finder finder_;
-    std::array<double, 3> box_hi_{};
-    bool has_cells_ = false;
     std::array<double, 12> unit_{};   // B^l as double, l = 0 .. levels (<= 10)
 };
 

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "octiso/octree.h"
+#include "octiso/render.h"
 #include "render/ray.h"
 #include "render/roots.h"
 
@@ -32,28 +33,56 @@ inline double snap_to_face(double p) {
     return p;
 }
 
-/// What a cell test needs besides the cell: the isovalues, the index-space ray, and for normals
-/// the spacing and the world direction.
-struct CellQuery {
-    const double* isovalues;
-    int iso_count;
-    const IndexRay* ray;
-    const std::array<double, 3>* spacing;
-    const std::array<double, 3>* world_dir;
-    bool want_normal;
+/// What every cell-walking tracer fixes once per render: the isovalues, the placement, and the
+/// closed data box [0, n-1]^3 that rays are clipped to (CONVENTIONS 1: only cells inside exist).
+struct CellWalkScene {
+    double isovalues[kMaxIsovalues] = {};
+    int iso_count = 0;
+    Placement placement;
+    std::array<double, 3> box_hi{};
+    bool has_cells = false;   ///< false when an extent is 1: no cell exists, nothing is ever hit
+
+    CellWalkScene(Dims dims, const Placement& p, const double* isos, int count) : iso_count(count), placement(p) {
+        for (int i = 0; i < count; ++i) isovalues[i] = isos[i];
+        box_hi = {double(dims.x) - 1, double(dims.y) - 1, double(dims.z) - 1};
+        has_cells = dims.x >= 2 && dims.y >= 2 && dims.z >= 2;
+    }
+    bool any_iso_in(double lo, double hi) const {
+        for (int i = 0; i < iso_count; ++i)
+            if (lo <= isovalues[i] && isovalues[i] <= hi) return true;
+        return false;
+    }
+};
+
+/// Per-ray state of a cell walk: the index-space ray, where it leaves the data, and the hit so far.
+struct RayState {
+    IndexRay ray;
+    std::array<double, 3> world_dir{};
+    double t_exit = 0;
+    bool want_normal = false;
+    TraceHit hit;
+
+    /// Starts `ray_world` in `scene`: returns the piece inside the data box, empty on a miss.
+    BoxClip start(const CellWalkScene& scene, const Ray& ray_world, bool normal) {
+        world_dir = ray_world.dir;
+        want_normal = normal;
+        if (!scene.has_cells) return {};
+        ray = index_from_world(ray_world, scene.placement);
+        const BoxClip clip = clip_to_box(ray, scene.box_hi);
+        t_exit = clip.t_out;
+        return clip;
+    }
 };
 
 /// Tests cell v (lower corner, index space) with corners `corner` (order i + 2j + 4k) on the ray
-/// piece [t_in, t_out) ([t_in, t_out] when closed_end). On a hit fills `hit` and returns true.
+/// piece [t_in, t_out) ([t_in, t_out] when closed_end). On a hit fills `w.hit` and returns true.
 template <class Finder>
-inline bool intersect_cell(const Finder& finder, const CellQuery& q, const Coord& v, const double corner[8], double t_in,
-                           double t_out, bool closed_end, TraceHit& hit) {
+inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
+                           const double corner[8], double t_in, double t_out, bool closed_end) {
     double lo = corner[0], hi = corner[0];
     for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
-    bool any = false;   // a NaN corner fails every comparison, so such a cell is never tested
-    for (int i = 0; i < q.iso_count; ++i) any |= lo <= q.isovalues[i] && q.isovalues[i] <= hi;
-    if (!any) return false;
-    const IndexRay& r = *q.ray;
+    if (!scene.any_iso_in(lo, hi)) return false;   // a NaN corner fails every comparison
+    const IndexRay& r = w.ray;
     const std::array<double, 3> o_cell{r.origin[0] - double(v.x), r.origin[1] - double(v.y), r.origin[2] - double(v.z)};
     std::array<double, 3> p_in, p_out;
     for (int a = 0; a < 3; ++a) {
@@ -62,18 +91,19 @@ inline bool intersect_cell(const Finder& finder, const CellQuery& q, const Coord
     }
     double best_s = 2.0;
     int best = -1;
-    for (int i = 0; i < q.iso_count; ++i) {
-        if (!(lo <= q.isovalues[i] && q.isovalues[i] <= hi)) continue;
-        const double s = first_root(finder, corner, q.isovalues[i], p_in, p_out, closed_end);
+    for (int i = 0; i < scene.iso_count; ++i) {
+        const double iso = scene.isovalues[i];
+        if (!(lo <= iso && iso <= hi)) continue;
+        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end);
         if (s >= 0 && s < best_s) best_s = s, best = i;
     }
     if (best < 0) return false;
-    hit.t = t_in + best_s * (t_out - t_in);
-    hit.iso_index = best;
-    if (q.want_normal) {
+    w.hit.t = t_in + best_s * (t_out - t_in);
+    w.hit.iso_index = best;
+    if (w.want_normal) {
         std::array<double, 3> p_hit;
         for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + best_s * (p_out[a] - p_in[a]);
-        hit.normal = world_normal(corner, p_hit, *q.spacing, *q.world_dir);
+        w.hit.normal = world_normal(corner, p_hit, scene.placement.spacing, w.world_dir);
     }
     return true;
 }

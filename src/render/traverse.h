@@ -43,43 +43,21 @@ template <typename T, class Finder, class Corners = OctreeCornerSource> class Oc
 public:
     OctreeTracer(const Octree<T>& tree, const Placement& placement, const double* isovalues, int iso_count,
                  const Finder& finder, const Corners& corners = Corners{})
-        : tree_(tree), placement_(placement), iso_count_(iso_count), finder_(finder), corners_(corners) {
-        for (int i = 0; i < iso_count; ++i) iso_[i] = isovalues[i];
-        const Dims d = tree.dims();
-        box_hi_ = {double(d.x) - 1, double(d.y) - 1, double(d.z) - 1};
-        has_cells_ = d.x >= 2 && d.y >= 2 && d.z >= 2;
-    }
+        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), finder_(finder), corners_(corners) {}
 
     /// First hit along the world ray; the normal is computed only if `want_normal`.
     /// Thread-safe: all per-ray state lives on the caller's stack.
     TraceHit trace(const Ray& ray_world, bool want_normal) const {
         Walk w;
-        w.world_dir = ray_world.dir;
-        w.want_normal = want_normal;
-        if (!has_cells_) return w.hit;
-        w.ray = index_from_world(ray_world, placement_);
-        const BoxClip clip = clip_to_box(w.ray, box_hi_);
-        if (clip.empty()) return w.hit;
-        w.t_exit = clip.t_out;
-        node(w, 0, 0, Coord{}, clip.t_in, clip.t_out);
+        const BoxClip clip = w.start(scene_, ray_world, want_normal);
+        if (!clip.empty()) node(w, 0, 0, Coord{}, clip.t_in, clip.t_out);
         return w.hit;
     }
 
 private:
-    struct Walk {
-        IndexRay ray;
-        std::array<double, 3> world_dir{};
-        double t_exit = 0;
-        bool want_normal = false;
-        uint32_t trace[kMaxDepth];
-        TraceHit hit;
+    struct Walk : RayState {
+        uint32_t trace[kMaxDepth];   ///< parent trace: node index at each depth down to the current one
     };
-
-    bool any_iso_in(double lo, double hi) const {
-        for (int i = 0; i < iso_count_; ++i)
-            if (lo <= iso_[i] && iso_[i] <= hi) return true;
-        return false;
-    }
 
     /// Whether the ray is on the upper side of the plane p[a] == plane at time t (the side it
     /// occupies on [t, t + dt) for small dt): decided from times, never from positions. A ray lying
@@ -89,7 +67,7 @@ private:
         const double d = r.dir[a];
         if (d > 0) return t_plane <= t;
         if (d < 0) return t < t_plane;
-        return r.origin[a] > plane || (r.origin[a] == plane && plane < box_hi_[a]);
+        return r.origin[a] > plane || (r.origin[a] == plane && plane < scene_.box_hi[a]);
     }
 
     // Node origins travel by reference: a Coord passed by value is assembled with 32-bit stores
@@ -118,7 +96,7 @@ private:
             double t_next = t1;
             if (i < 3 && tm[order[i]] > t0 && tm[order[i]] < t1) t_next = tm[order[i]];
             else if (i < 3) continue;   // this axis is not crossed inside [t0, t1)
-            if (t_next > t_cur && n.may_contain_any(c, iso_, iso_count_)) {
+            if (t_next > t_cur && n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) {
                 const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
                 bool hit;
                 if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, d, co, half, n.scalar[c], t_cur, t_next);
@@ -192,7 +170,7 @@ private:
             }
         };
         bool iso_equals_value = false;
-        for (int i = 0; i < iso_count_; ++i) iso_equals_value |= iso_[i] == v;
+        for (int i = 0; i < scene_.iso_count; ++i) iso_equals_value |= scene_.isovalues[i] == v;
         if (iso_equals_value) return walk_cells(w, co, side, t0, t1, gather);
 
         // Skip the inner cells [co, co + side - 1)^3: constant, never crossed by another iso.
@@ -227,7 +205,7 @@ private:
         for (int a = 0; a < 3; ++a) {
             const double p = r.origin[a] + t0 * r.dir[a];
             int64_t i = int64_t(std::floor(p));
-            if (r.dir[a] == 0 && p == box_hi_[a]) i = int64_t(last_cell[a]);   // lying in the top face
+            if (r.dir[a] == 0 && p == scene_.box_hi[a]) i = int64_t(last_cell[a]);   // lying in the top face
             const int64_t b0 = box_lo[a], b1 = int64_t(box_lo[a]) + side - 1;
             i = std::clamp(i, b0, b1);
             // Settle rounding of p at a cell face with the same plane times the DDA steps on.
@@ -267,18 +245,13 @@ private:
     }
 
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
-        const CellQuery q{iso_, iso_count_, &w.ray, &placement_.spacing, &w.world_dir, w.want_normal};
-        return intersect_cell(finder_, q, v, corner, t_in, t_out, closed_end, w.hit);
+        return intersect_cell(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
     }
 
     const Octree<T> tree_;   // a view: cheap to copy, and no dangling reference to a temporary
-    const Placement placement_;
-    double iso_[kMaxIsovalues] = {};
-    int iso_count_;
+    const CellWalkScene scene_;
     const Finder finder_;
     [[no_unique_address]] const Corners corners_;
-    std::array<double, 3> box_hi_{};
-    bool has_cells_ = false;
 };
 
 }  // namespace octiso
