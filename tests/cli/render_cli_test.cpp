@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "test_util/run_shell.h"
 #include "octiso/image.h"
 #include "test_util/scratch_dir.h"
 
@@ -24,25 +25,11 @@ struct TempDir : ScratchDir {
 };
 
 int run(const std::string& tool, const std::string& args, std::string* out = nullptr, std::string* err = nullptr) {
-    static int n = 0;
-    const std::string err_file = (fs::temp_directory_path() / ("octiso_err_" + std::to_string(::getpid()) + "_" + std::to_string(n++))).string();
-    const std::string cmd = "'" + kTools + "/" + tool + "' " + args + " 2>'" + err_file + "'";
-    std::FILE* p = ::popen(cmd.c_str(), "r");
-    if (!p) return -1;
-    std::string text;
-    char buf[4096];
-    size_t k;
-    while ((k = std::fread(buf, 1, sizeof buf, p)) > 0) text.append(buf, k);
-    const int status = ::pclose(p);
-    if (out) *out = text;
-    if (err) {
-        std::FILE* f = std::fopen(err_file.c_str(), "r");
-        err->clear();
-        while (f && (k = std::fread(buf, 1, sizeof buf, f)) > 0) err->append(buf, k);
-        if (f) std::fclose(f);
-    }
-    std::remove(err_file.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    ScratchDir stderr_dir("octiso_render_cli_err");
+    const std::string err_file = stderr_dir.file("stderr");
+    const int status = run_shell("'" + kTools + "/" + tool + "' " + args + " 2>'" + err_file + "'", out);
+    if (err) run_shell("cat '" + err_file + "'", err);
+    return status;
 }
 
 class RenderCli : public ::testing::Test {

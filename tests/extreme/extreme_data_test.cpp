@@ -16,6 +16,7 @@
 #include <fstream>
 #include <limits>
 
+#include "test_util/run_shell.h"
 #include "test_util/scratch_dir.h"
 #include "octiso/build.h"
 #include "octiso/decode.h"
@@ -101,17 +102,7 @@ TYPED_TEST(ExtremeValues, ValuesAtTheLimitsOfTheType) {
 
 // ---------------------------------------------------------------------------------------------
 /// Exit status of a shell command; its stdout and stderr are captured together in `out`.
-int run(const std::string& cmd, std::string* out = nullptr) {
-    std::FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
-    if (!p) return -1;
-    std::string text;
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) text.append(buf, n);
-    const int status = ::pclose(p);
-    if (out) *out = text;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int run(const std::string& cmd, std::string* out = nullptr) { return run_shell(cmd + " 2>&1", out); }
 
 struct Dir : ScratchDir {
     Dir() : ScratchDir("octiso_extreme") {}

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "test_util/run_shell.h"
 #include "format/oct_test_util.h"
 
 namespace octiso::test {
@@ -14,16 +15,7 @@ namespace {
 const std::string kInfo = std::string(OCTISO_TOOLS_DIR) + "/octiso-info";
 
 /// Runs a shell command; returns its exit status and captures stdout.
-int run(const std::string& cmd, std::string& out) {
-    out.clear();
-    std::FILE* p = ::popen(cmd.c_str(), "r");
-    if (!p) return -1;
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-    const int status = ::pclose(p);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int run(const std::string& cmd, std::string& out) { return run_shell(cmd, &out); }
 
 class InfoCli : public ::testing::Test {
 protected:

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "test_util/run_shell.h"
 #include "octiso/decode.h"
 #include "octiso/oct_file.h"
 #include "octiso/synthetic.h"
@@ -30,16 +31,7 @@ struct CliDir : ScratchDir {
 
 /// Exit status of `args` run through the shell with stdout captured; stderr is discarded.
 int run(const std::string& args, std::string* out = nullptr) {
-    const std::string cmd = "'" + kConvert + "' " + args + " 2>/dev/null";
-    std::FILE* p = ::popen(cmd.c_str(), "r");
-    if (!p) return -1;
-    std::string text;
-    char buf[4096];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) text.append(buf, n);
-    const int status = ::pclose(p);
-    if (out) *out = text;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return run_shell("'" + kConvert + "' " + args + " 2>/dev/null", out);
 }
 
 template <typename T> std::vector<T> ramp(Dims d, int salt) {

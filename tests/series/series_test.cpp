@@ -12,6 +12,7 @@
 #include <fstream>
 #include <random>
 
+#include "test_util/run_shell.h"
 #include "format/oct_test_util.h"
 #include "octiso/build.h"
 #include "octiso/image.h"
@@ -28,9 +29,7 @@ const std::string kTools = OCTISO_TOOLS_DIR;
 
 /// Exit status of TOOL ARGS run through the shell; stdout and stderr are discarded.
 int run(const std::string& tool, const std::string& args) {
-    const std::string cmd = "'" + kTools + "/" + tool + "' " + args + " >/dev/null 2>&1";
-    const int status = std::system(cmd.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return run_shell("'" + kTools + "/" + tool + "' " + args + " >/dev/null 2>&1");
 }
 
 template <typename T> void write_values(const std::string& path, const std::vector<T>& v) {
