@@ -27,7 +27,7 @@
 
 #include "bench/bench.h"
 #include "octiso/error.h"
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 
 namespace octiso::bench {
 

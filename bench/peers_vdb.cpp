@@ -35,7 +35,7 @@ VdbPeerResult run_vdb_peer(const LoadedVolume&, double, const Camera&, int) {
 #include <vector>
 
 #include "bench/bench.h"
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 
 namespace octiso::bench {
 

@@ -21,7 +21,7 @@
 #include "octiso/render.h"
 #include "octiso/synthetic.h"
 #include "reference/reference_render.h"
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 #include "render/roots.h"
 #include "render/traverse.h"
 
@@ -64,7 +64,7 @@ double first_root(const RecordingFinder& r, const double corner[8], double iso, 
 }
 
 struct Config {
-    RootFinderKind kind;
+    RootFinder kind;
     int iterations;   ///< Neubauer's refinement steps; -1 for the others
     std::string label;
     bool is_default = false;
@@ -74,10 +74,10 @@ std::vector<Config> configs() {
     std::vector<Config> c;
     const int default_its = Neubauer{}.iterations;
     for (int n : {1, 2, 3, 4, 5, 6, 7, 8, 64})
-        c.push_back({RootFinderKind::neubauer, n, "neubauer " + std::to_string(n), n == default_its});
-    c.push_back({RootFinderKind::schwarze, -1, "schwarze"});
-    c.push_back({RootFinderKind::linear, -1, "linear"});
-    c.push_back({RootFinderKind::exact, -1, "exact"});
+        c.push_back({RootFinder::neubauer, n, "neubauer " + std::to_string(n), n == default_its});
+    c.push_back({RootFinder::schwarze, -1, "schwarze"});
+    c.push_back({RootFinder::linear, -1, "linear"});
+    c.push_back({RootFinder::exact, -1, "exact"});
     return c;
 }
 
@@ -211,7 +211,7 @@ void run_dataset(DatasetRun& run, const LoadedVolume& volume, const Camera& came
     for (const Config& cfg : cfgs) {
         RenderOptions options;
         options.isovalues = {run.iso};
-        options.root_finder = parse_root_finder_name(root_finder_name(cfg.kind));
+        options.root_finder = cfg.kind;
         options.iterations = cfg.iterations;
         options.want_colour = false;
         options.want_depth = options.want_normal = true;
@@ -338,7 +338,7 @@ int run_rootfinders(cli::Args& args) {
         run.s_ref = exact_roots(run.calls);
         std::cerr << "    " << run.calls.size() << " cell tests recorded; timing the finders\n";
         for (const Config& cfg : cfgs)
-            run.per_config.push_back(evaluate(cfg, run.calls, run.s_ref, min_solves, cfg.kind == RootFinderKind::exact ? 1 : timing_repeats));
+            run.per_config.push_back(evaluate(cfg, run.calls, run.s_ref, min_solves, cfg.kind == RootFinder::exact ? 1 : timing_repeats));
         runs.push_back(std::move(run));
     }
 
@@ -347,7 +347,7 @@ int run_rootfinders(cli::Args& args) {
     const std::vector<double> random_ref = exact_roots(random);
     std::vector<StreamResult> random_results;
     for (const Config& cfg : cfgs)
-        random_results.push_back(evaluate(cfg, random, random_ref, min_solves, cfg.kind == RootFinderKind::exact ? 1 : timing_repeats));
+        random_results.push_back(evaluate(cfg, random, random_ref, min_solves, cfg.kind == RootFinder::exact ? 1 : timing_repeats));
 
     // Pooled recorded streams: errors merged, ns weighted by the calls of each stream.
     std::vector<StreamResult> pooled(cfgs.size());

@@ -18,7 +18,7 @@
 #include "octiso/reader.h"
 #include "octiso/render.h"
 #include "octiso/synthetic.h"
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 #include "render/traverse.h"
 
 namespace octiso::bench {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "octiso/render.h"
+#include "octiso/frame.h"
 
 namespace octiso {
 

@@ -124,13 +124,18 @@ public:
     /// Climbs to the deepest traced node whose cube also contains `dest`, then locates down
     /// (Knoll 2006 App. B.2; the paper's trailing root check is folded into the loop at d = 0).
     T neighbour_find(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
+        return neighbour_locate(start, dest, depth, parent_trace).value;
+    }
+    /// The same, returning where the descent ended (the traversal then reads a whole forward
+    /// neighbour block directly).
+    LeafRef<T> neighbour_locate(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
         for (int d = depth; d > 0; --d) {
             const int shift = a_.dmax - d;   // cube side of a depth-d node is 2^shift
             if (((start.x ^ dest.x) >> shift) == 0 && ((start.y ^ dest.y) >> shift) == 0 &&
                 ((start.z ^ dest.z) >> shift) == 0)
-                return locate_from(dest, d, parent_trace[d]).value;
+                return locate_from(dest, d, parent_trace[d]);
         }
-        return locate_from(dest, 0, 0).value;
+        return locate_from(dest, 0, 0);
     }
 
 private:

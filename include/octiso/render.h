@@ -1,32 +1,26 @@
-// Rendering isosurfaces of an octree volume: the pinhole camera of CONVENTIONS 2, what a render is
-// asked for (isovalues, root finder, which outputs), and the Frame it returns (colour and the depth
-// and normal AOVs). render() runs tile-parallel on all cores (TBB) through an Embree scene, or
-// directly (`use_embree = false`) for comparison; both trace the same rays.
+// Rendering isosurfaces of an octree volume: what a render is asked for (RenderOptions) and the
+// persistent Renderer that answers it frame after frame. A Renderer is built once per octree
+// (or series step) and keeps the Embree device and scene, the thread arena and the traversal
+// set-up, so a series or an interactive session pays them once. render() is the one-call
+// convenience over it. Cameras are camera.h, frames frame.h, tiles tiles.h.
 #pragma once
 
 #include <array>
-#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "octiso/camera.h"
+#include "octiso/frame.h"
+#include "octiso/limits.h"
 #include "octiso/octree.h"
+#include "octiso/root_finder.h"
+#include "octiso/tiles.h"
 #include "octiso/volume.h"
 
 namespace octiso {
-
-/// Perspective pinhole, world units (CONVENTIONS 2). fov_deg is the vertical field of view.
-struct Camera {
-    std::array<double, 3> eye{0, 0, 0}, look{0, 0, 1}, up{0, 1, 0};
-    double fov_deg = 40.0;
-    int width = 512, height = 512;
-};
-
-/// A camera that frames the data box of `dims` placed by `placement` from a three-quarter view.
-Camera frame_data_box(Dims dims, const Placement& placement, int width, int height);
-
-enum class RootFinder { neubauer, schwarze, linear, exact };
-/// "neubauer", "schwarze", "linear", "exact"; throws Error("--root-finder", ...) otherwise.
-RootFinder parse_root_finder_name(const std::string& name);
 
 struct RenderOptions {
     std::vector<double> isovalues;      ///< 1 .. kMaxIsovalues, each with its own colour
@@ -37,34 +31,61 @@ struct RenderOptions {
     bool want_normal = false;
     bool use_embree = true;             ///< false: call the traversal directly (no Embree dispatch)
     int threads = 0;                    ///< 0: all cores
-    /// Square tile side in pixels; 0 picks it: 16 when the frame holds at least 4096 such tiles,
-    /// else 8, so even 512^2 frames have enough tiles to balance many cores (octiso-bench scaling:
-    /// simulated 64-thread efficiency at 512^2 82 % with 16x16 tiles, 96 % with 8x8).
-    int tile_size = 0;
-};
-inline constexpr int kMaxIsovalues = 8;
-
-struct RenderStats {
-    double seconds = 0;                 ///< wall time of the tile loop
-    uint64_t rays = 0, hits = 0;
-    int threads = 0;
-    double mrays_per_second() const { return seconds > 0 ? double(rays) / seconds * 1e-6 : 0; }
+    int tile_size = 0;                  ///< square tile side in pixels; 0: tile_size_for() picks it
 };
 
-/// One rendered image. Row 0 is the top row. Empty vectors for outputs not asked for.
-struct Frame {
-    int width = 0, height = 0;
-    std::vector<uint8_t> rgb;           ///< 8-bit sRGB, 3 per pixel
-    std::vector<float> depth;           ///< world distance t, +inf on a miss
-    std::vector<float> normal;          ///< world unit normal facing the ray, 0,0,0 on a miss
-    RenderStats stats;
+/// What the renderer must know about the octree's source beyond its voxels: a file converted
+/// with --iso-range LO,HI is exact only for isovalues strictly inside (LO, HI).
+struct RenderLimits {
+    std::optional<std::array<double, 2>> iso_range;
+    std::string source;                 ///< the file, named in the refusal
 };
 
-/// The tile side render() uses for a frame of width x height under `requested` (0: automatic).
-int tile_size_for(int width, int height, int requested);
+class Renderer {
+public:
+    /// Prepares rendering `tree` placed in the world by `placement`. The octree's storage (an
+    /// OctreeData or a mapped OctFile) must outlive the Renderer. Throws Error on bad options
+    /// (set_options) or when Embree cannot be set up.
+    template <typename T>
+    Renderer(const Octree<T>& tree, const Placement& placement, const RenderOptions& options,
+             const RenderLimits& limits = {});
+    ~Renderer();
+    Renderer(Renderer&&) noexcept;
+    Renderer& operator=(Renderer&&) noexcept;
 
-/// Renders the isosurfaces of `tree` placed in the world by `placement`. Throws Error on bad
-/// options (no isovalue, too many). Thread-safe for distinct frames.
+    /// New isovalues, root finder, outputs or threads; validated as at construction. The Embree
+    /// device and scene are kept. Not to be called while a render of this Renderer runs.
+    void set_options(const RenderOptions& options);
+    const RenderOptions& options() const;
+    ScalarType type() const;
+
+    /// The tiles a frame of width x height is cut into under these options.
+    TileGrid tile_grid(int width, int height) const;
+
+    /// Renders the whole frame into `frame`, resized to the camera (buffers are reused when the
+    /// size and outputs match the previous frame). Throws Error for an invalid camera.
+    /// Thread-safe for distinct frames.
+    RenderStats render(const Camera& camera, Frame& frame) const;
+    Frame render(const Camera& camera) const;
+
+    /// Sizes `frame` for `camera` and these options (as render() does) without tracing.
+    void prepare_frame(const Camera& camera, Frame& frame) const;
+    /// Renders only `tiles` (indices into tile_grid(camera.width, camera.height)) into `frame`,
+    /// which prepare_frame() sized; pixels of other tiles are left as they are. Throws Error for
+    /// an invalid camera, a frame of another size or a tile index out of range.
+    RenderStats render_tiles(const Camera& camera, std::span<const int> tiles, Frame& frame) const;
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+/// Throws Error(flag, ...) unless `options` can be rendered: 1 .. kMaxIsovalues finite
+/// isovalues (inside the iso-range of `limits`, if any), a non-negative tile size.
+void validate_options(const RenderOptions& options, const RenderLimits& limits = {});
+
+/// One frame in one call: a Renderer built, used once and dropped. Throws Error on bad options.
 template <typename T>
 Frame render(const Octree<T>& tree, const Placement& placement, const Camera& camera, const RenderOptions& options);
 

@@ -89,12 +89,8 @@ int run(std::vector<std::string>& argv) {
     if (out_path) check_image_path(name_for(out_path, "-o", first), "-o");
     if (depth_path) check_image_path(name_for(depth_path, "--depth", first), "--depth");
     if (normal_path) check_image_path(name_for(normal_path, "--normal", first), "--normal");
-    if (info.iso_range)
-        for (double iso : options.isovalues)
-            if (!(iso > (*info.iso_range)[0] && iso < (*info.iso_range)[1]))
-                throw Error("--iso", "isovalue " + std::to_string(iso) + " lies outside the file's iso-range (" +
-                                         std::to_string((*info.iso_range)[0]) + ", " + std::to_string((*info.iso_range)[1]) +
-                                         "): the data there was clamped when " + inputs[0] + " was converted");
+    const RenderLimits limits{info.iso_range, inputs[0]};
+    validate_options(options, limits);
 
     Camera camera;
     {
@@ -121,9 +117,10 @@ int run(std::vector<std::string>& argv) {
     Progress progress(last - first + 1);
     double total_seconds = 0;
     for (long long k = first; k <= last; ++k) {
-        const Frame frame = dispatch_scalar_type(info.type, [&](auto tag) {
+        Frame frame;
+        dispatch_scalar_type(info.type, [&](auto tag) {
             using T = decltype(tag);
-            return render(file.step<T>(uint32_t(k)), info.placement, camera, options);
+            Renderer(file.step<T>(uint32_t(k)), info.placement, options, limits).render(camera, frame);
         });
         if (out_path) write_colour_image(name_for(out_path, "-o", k), frame);
         if (depth_path) write_depth_image(name_for(depth_path, "--depth", k), frame);

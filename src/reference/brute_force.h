@@ -9,7 +9,7 @@
 #include <limits>
 
 #include "octiso/volume.h"
-#include "render/ray.h"
+#include "math/ray.h"
 #include "render/roots.h"
 
 namespace octiso {

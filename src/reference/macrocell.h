@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "octiso/octree.h"
-#include "octiso/render.h"
+#include "octiso/limits.h"
 #include "octiso/volume.h"
-#include "render/ray.h"
+#include "math/ray.h"
 #include "render/roots.h"
 #include "render/traverse.h"
 

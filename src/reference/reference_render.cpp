@@ -5,7 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 
 namespace octiso {
 

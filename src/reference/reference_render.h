@@ -3,7 +3,8 @@
 // (median, p99, max over pixels both hit) and normal angle error in degrees (median, max).
 #pragma once
 
-#include "octiso/render.h"
+#include "octiso/camera.h"
+#include "octiso/frame.h"
 #include "reference/brute_force.h"
 
 namespace octiso {

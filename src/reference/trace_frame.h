@@ -1,20 +1,17 @@
 // One depth (+ normal) frame from any tracer with `TraceHit trace(const Ray&, bool want_normal)`,
-// with the renderer's tile loop (TBB 16x16 tiles, simple partitioner, work stealing) but no
-// Embree and no shading, so the acceleration structures of the grid benchmark are compared on
-// equal terms. The caller's task_arena decides the thread count.
+// through the renderer's own tile loop (render/tile_loop.h) but without Embree and shading, so
+// the acceleration structures of the grid benchmark and the tests are compared on equal terms.
+// The caller's task_arena decides the thread count.
 #pragma once
 
-#include <atomic>
-#include <chrono>
 #include <cmath>
 
-#include <tbb/blocked_range2d.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
-#include "octiso/render.h"
-#include "render/camera.h"
-#include "render/traverse.h"
+#include "math/hit.h"
+#include "octiso/camera.h"
+#include "octiso/frame.h"
+#include "octiso/tiles.h"
+#include "render/pinhole_camera.h"
+#include "render/tile_loop.h"
 
 namespace octiso {
 
@@ -27,28 +24,18 @@ template <class Tracer> Frame trace_frame(const Tracer& tracer, const Camera& ca
     frame.height = H;
     frame.depth.assign(size_t(W) * H, INFINITY);
     if (want_normal) frame.normal.assign(size_t(W) * H * 3, 0.0f);
-    std::atomic<uint64_t> hits{0};
-    const auto t0 = std::chrono::steady_clock::now();
-    tbb::parallel_for(
-        tbb::blocked_range2d<int>(0, H, tile_size, 0, W, tile_size),
-        [&](const tbb::blocked_range2d<int>& tile) {
-            uint64_t tile_hits = 0;
-            for (int py = tile.rows().begin(); py < tile.rows().end(); ++py)
-                for (int px = tile.cols().begin(); px < tile.cols().end(); ++px) {
-                    const TraceHit hit = tracer.trace(pinhole.ray(px, py), want_normal);
-                    const size_t i = size_t(py) * W + px;
-                    frame.depth[i] = float(hit.t);
-                    if (want_normal && hit.is_hit())
-                        for (int a = 0; a < 3; ++a) frame.normal[3 * i + a] = float(hit.normal[a]);
-                    tile_hits += hit.is_hit();
-                }
-            hits += tile_hits;
-        },
-        tbb::simple_partitioner());
-    frame.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    frame.stats.rays = uint64_t(W) * H;
-    frame.stats.hits = hits;
-    frame.stats.threads = tbb::this_task_arena::max_concurrency();
+    frame.stats = for_each_tile(TileGrid{W, H, tile_size}, {}, true, [&](const PixelRect& rect, TileCounters& counters) {
+        for (int py = rect.y0; py < rect.y1; ++py)
+            for (int px = rect.x0; px < rect.x1; ++px) {
+                const TraceHit hit = tracer.trace(pinhole.ray(px, py), want_normal);
+                const size_t i = size_t(py) * W + px;
+                frame.depth[i] = float(hit.t);
+                if (want_normal && hit.is_hit())
+                    for (int a = 0; a < 3; ++a) frame.normal[3 * i + a] = float(hit.normal[a]);
+                counters.hits += hit.is_hit();
+            }
+        counters.rays += uint64_t(rect.x1 - rect.x0) * uint64_t(rect.y1 - rect.y0);
+    });
     return frame;
 }
 

@@ -10,18 +10,12 @@
 #include <limits>
 
 #include "octiso/octree.h"
-#include "octiso/render.h"
-#include "render/ray.h"
+#include "math/hit.h"
+#include "math/ray.h"
+#include "octiso/limits.h"
 #include "render/roots.h"
 
 namespace octiso {
-
-struct TraceHit {
-    double t = std::numeric_limits<double>::infinity();   ///< world distance; +inf: miss
-    std::array<double, 3> normal{0, 0, 0};
-    int iso_index = -1;
-    bool is_hit() const { return iso_index >= 0; }
-};
 
 /// A coordinate that rounding left a hair off a cell face is put exactly on it, so that two
 /// cells sharing that face evaluate bitwise the same value there (cell.h) and the half-open

@@ -8,9 +8,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <optional>
-#include <string_view>
 
+#include "octiso/root_finder.h"
 #include "render/cell.h"
 
 namespace octiso {
@@ -296,41 +295,20 @@ inline double first_root(const Finder& finder, const double corner[8], double is
     return kNoHit;
 }
 
-/// The root finders by name, for --root-finder and the benchmarks.
-enum class RootFinderKind { neubauer, schwarze, linear, exact };
-
-inline std::optional<RootFinderKind> parse_root_finder(std::string_view name) {
-    if (name == Neubauer::name) return RootFinderKind::neubauer;
-    if (name == Schwarze::name) return RootFinderKind::schwarze;
-    if (name == Linear::name) return RootFinderKind::linear;
-    if (name == Exact::name) return RootFinderKind::exact;
-    return std::nullopt;
-}
-
-inline const char* root_finder_name(RootFinderKind kind) {
-    switch (kind) {
-        case RootFinderKind::neubauer: return Neubauer::name;
-        case RootFinderKind::schwarze: return Schwarze::name;
-        case RootFinderKind::linear: return Linear::name;
-        case RootFinderKind::exact: break;
-    }
-    return Exact::name;
-}
-
 /// Calls f(finder) with a value of the policy type for `kind`, once, outside the hot loop, so
 /// the caller's loop is instantiated (and inlined) per policy. `iterations` configures Neubauer's
 /// refinement steps (< 0 keeps the default); the other policies ignore it (Exact always bisects
 /// to the last bit).
-template <class F> decltype(auto) dispatch_root_finder(RootFinderKind kind, int iterations, F&& f) {
+template <class F> decltype(auto) dispatch_root_finder(RootFinder kind, int iterations, F&& f) {
     switch (kind) {
-        case RootFinderKind::neubauer: {
+        case RootFinder::neubauer: {
             Neubauer p;
             if (iterations >= 0) p.iterations = iterations;
             return f(p);
         }
-        case RootFinderKind::schwarze: return f(Schwarze{});
-        case RootFinderKind::linear: return f(Linear{});
-        case RootFinderKind::exact: break;
+        case RootFinder::schwarze: return f(Schwarze{});
+        case RootFinder::linear: return f(Linear{});
+        case RootFinder::exact: break;
     }
     return f(Exact{});
 }

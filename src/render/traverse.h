@@ -24,10 +24,9 @@
 #include <type_traits>
 
 #include "octiso/octree.h"
-#include "octiso/render.h"
 #include "render/cell.h"
 #include "render/cell_hit.h"
-#include "render/ray.h"
+#include "math/ray.h"
 #include "render/roots.h"
 
 namespace octiso {
@@ -111,17 +110,6 @@ private:
         return false;
     }
 
-    /// Octree<T>::neighbour_find, returning where the descent ended instead of only the value.
-    LeafRef<T> locate_neighbour(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
-        for (int d = depth; d > 0; --d) {
-            const int shift = tree_.dmax() - d;
-            if (((start.x ^ dest.x) >> shift) == 0 && ((start.y ^ dest.y) >> shift) == 0 &&
-                ((start.z ^ dest.z) >> shift) == 0)
-                return tree_.locate_from(dest, d, parent_trace[d]);
-        }
-        return tree_.locate_from(dest, 0, 0);
-    }
-
     bool cap(Walk& w, uint32_t cap_index, const Coord& co, double t0, double t1) const {
         w.trace[tree_.dmax() - 1] = cap_index;
         const Cap<T>& cap = tree_.cap(cap_index);
@@ -145,7 +133,7 @@ private:
                 }
                 if (!((located >> r) & 1u)) {
                     const Coord b{co.x + ((r & 4) ? 2u : 0u), co.y + ((r & 2) ? 2u : 0u), co.z + ((r & 1) ? 2u : 0u)};
-                    block[r] = locate_neighbour(co, b, tree_.dmax() - 1, w.trace);
+                    block[r] = tree_.neighbour_locate(co, b, tree_.dmax() - 1, w.trace);
                     located |= 1u << r;
                 }
                 corner[k] = block[r].in_cap ? double(tree_.cap(block[r].index).voxel[(oct | dir) & ~r])

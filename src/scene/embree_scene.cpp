@@ -76,9 +76,24 @@ void occluded_callback(const RTCOccludedFunctionNArguments* args) noexcept {
     }
 }
 
-void error_callback(void* user, RTCError code, const char* message) {
-    auto* last = static_cast<std::string*>(user);
-    *last = "Embree error " + std::to_string(int(code)) + (message ? std::string(": ") + message : std::string());
+/// The one Embree device of the process, created on first use and shared by every scene: a
+/// device starts Embree's internal state once, while scenes are cheap, so a 153-step series or
+/// an interactive session pays the device once. Embree devices are thread-safe for creating
+/// scenes. Errors land in a per-thread slot that commit() reads.
+thread_local std::string t_last_error;
+
+void device_error_callback(void*, RTCError code, const char* message) {
+    t_last_error = "Embree error " + std::to_string(int(code)) + (message ? std::string(": ") + message : std::string());
+}
+
+RTCDevice shared_device() {
+    static const RTCDevice device = [] {
+        RTCDevice d = rtcNewDevice(nullptr);
+        if (d) rtcSetDeviceErrorFunction(d, device_error_callback, nullptr);
+        return d;
+    }();
+    if (!device) throw Error("embree", "cannot create a device", ErrorKind::Other);
+    return device;
 }
 
 }  // namespace
@@ -87,20 +102,17 @@ struct EmbreeVolumeScene::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<std::unique_ptr<VolumeGeometry>> geometries;
-    std::string last_error;
 };
 
 EmbreeVolumeScene::EmbreeVolumeScene() : impl_(std::make_unique<Impl>()) {
-    impl_->device = rtcNewDevice(nullptr);
-    if (!impl_->device) throw Error("embree", "cannot create a device", ErrorKind::Other);
-    rtcSetDeviceErrorFunction(impl_->device, error_callback, &impl_->last_error);
+    impl_->device = shared_device();
     impl_->scene = rtcNewScene(impl_->device);
+    if (!impl_->scene) throw Error("embree", "cannot create a scene: " + t_last_error, ErrorKind::Other);
     rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
 }
 
 EmbreeVolumeScene::~EmbreeVolumeScene() {
     if (impl_->scene) rtcReleaseScene(impl_->scene);
-    if (impl_->device) rtcReleaseDevice(impl_->device);
 }
 
 void EmbreeVolumeScene::add_volume(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const void* user,
@@ -117,9 +129,16 @@ void EmbreeVolumeScene::add_volume(const std::array<double, 3>& lo, const std::a
     rtcReleaseGeometry(geom);
 }
 
+void EmbreeVolumeScene::set_volume_trace(size_t index, const void* user, TraceFn trace) {
+    VolumeGeometry& g = *impl_->geometries.at(index);
+    g.user = user;
+    g.trace = trace;
+}
+
 void EmbreeVolumeScene::commit() {
+    t_last_error.clear();
     rtcCommitScene(impl_->scene);
-    if (!impl_->last_error.empty()) throw Error("embree", impl_->last_error, ErrorKind::Other);
+    if (!t_last_error.empty()) throw Error("embree", t_last_error, ErrorKind::Other);
 }
 
 TraceHit EmbreeVolumeScene::intersect(const Ray& ray, bool want_normal) const {

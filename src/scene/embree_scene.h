@@ -1,14 +1,16 @@
 // EmbreeVolumeScene: an Embree 3 scene with one user geometry per volume, whose bounds are the
 // volume's data box in world space and whose intersect callback runs the octree traversal.
-// Primary rays go through rtcIntersect1. Embree's RTCRay holds floats, so the exact double ray
+// Primary rays go through rtcIntersect8 (packets along tile rows) or rtcIntersect1. Embree's RTCRay holds floats, so the exact double ray
 // travels beside it in an extended intersect context; the callback traces that one, and the
 // Embree and direct paths return bit-identical hits.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <memory>
 
-#include "render/traverse.h"
+#include "math/hit.h"
+#include "math/ray.h"
 
 namespace octiso {
 
@@ -27,6 +29,9 @@ public:
 
     /// Adds a volume whose world bounds are [lo, hi]; `user` must outlive the scene.
     void add_volume(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const void* user, TraceFn trace);
+    /// Points volume `index` (in add_volume order) at another traced object; bounds stay. Not
+    /// while a ray of this scene is in flight.
+    void set_volume_trace(size_t index, const void* user, TraceFn trace);
     void commit();
     /// First hit of `ray` (world, unit direction) over all geometries. Thread-safe after commit().
     TraceHit intersect(const Ray& ray, bool want_normal) const;

@@ -17,7 +17,7 @@
 #include "octiso/render.h"
 #include "octree/sparse_synthetic.h"
 #include "reference/brute_force.h"
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 #include "render/traverse.h"
 
 namespace octiso::test {

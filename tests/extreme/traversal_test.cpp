@@ -22,7 +22,7 @@
 #include "octree/octree_test_util.h"
 #include "reference/brute_force.h"
 #include "reference/reference_render.h"
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 #include "render/traverse.h"
 
 namespace octiso::test {

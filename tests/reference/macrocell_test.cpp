@@ -10,7 +10,7 @@
 #include "reference/brute_force.h"
 #include "reference/macrocell.h"
 #include "reference/trace_frame.h"
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 #include "render/render_test_util.h"
 
 namespace octiso::test {

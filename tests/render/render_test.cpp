@@ -7,7 +7,7 @@
 #include "octiso/build.h"
 #include "octiso/render.h"
 #include "reference/brute_force.h"
-#include "render/camera.h"
+#include "render/pinhole_camera.h"
 #include "render/render_test_util.h"
 
 namespace octiso::test {

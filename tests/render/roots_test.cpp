@@ -558,9 +558,9 @@ TEST(RootFinderDispatch, ParseAndDispatchPickThePolicy) {
     }
     EXPECT_FALSE(parse_root_finder("newton").has_value());
     EXPECT_FALSE(parse_root_finder("").has_value());
-    const int its = dispatch_root_finder(RootFinderKind::neubauer, 9, [](const auto& f) { return f.iterations; });
+    const int its = dispatch_root_finder(octiso::RootFinder::neubauer, 9, [](const auto& f) { return f.iterations; });
     EXPECT_EQ(its, 9);
-    EXPECT_EQ(dispatch_root_finder(RootFinderKind::neubauer, -1, [](const auto& f) { return f.iterations; }),
+    EXPECT_EQ(dispatch_root_finder(octiso::RootFinder::neubauer, -1, [](const auto& f) { return f.iterations; }),
               Neubauer{}.iterations);
 }
 

@@ -4,24 +4,11 @@
 
 #include <cmath>
 
-#include "octiso/render.h"
-#include "render/ray.h"
+#include "math/ray.h"
+#include "math/vec.h"
+#include "octiso/camera.h"
 
 namespace octiso {
-
-inline std::array<double, 3> vec_sub(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-inline std::array<double, 3> vec_cross(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-inline double vec_dot(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-inline std::array<double, 3> vec_normalized(const std::array<double, 3>& a) {
-    const double len = std::sqrt(vec_dot(a, a));
-    return {a[0] / len, a[1] / len, a[2] / len};
-}
 
 class PinholeCamera {
 public:
@@ -30,7 +17,7 @@ public:
         forward_ = vec_normalized(vec_sub(c.look, c.eye));
         right_ = vec_normalized(vec_cross(forward_, c.up));
         up_ = vec_cross(right_, forward_);
-        a_ = std::tan(c.fov_deg * 0.5 * 3.14159265358979323846 / 180.0);
+        a_ = std::tan(radians_from_degrees(c.fov_deg * 0.5));
     }
 
     /// World ray through the centre of pixel (px, py); py = 0 is the top row.

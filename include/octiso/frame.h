@@ -1,0 +1,26 @@
+// Frame: one rendered image (8-bit sRGB colour and the depth and normal AOVs of CONVENTIONS 2)
+// and what rendering it cost. Row 0 is the top row; pixel (x, y) is element y * width + x.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace octiso {
+
+struct RenderStats {
+    double seconds = 0;                 ///< wall time of the tile loop
+    uint64_t rays = 0, hits = 0;
+    int threads = 0;
+    double mrays_per_second() const { return seconds > 0 ? double(rays) / seconds * 1e-6 : 0; }
+};
+
+/// Empty vectors for outputs not asked for.
+struct Frame {
+    int width = 0, height = 0;
+    std::vector<uint8_t> rgb;           ///< 8-bit sRGB, 3 per pixel
+    std::vector<float> depth;           ///< world distance t, +inf on a miss
+    std::vector<float> normal;          ///< world unit normal facing the ray, 0,0,0 on a miss
+    RenderStats stats;
+};
+
+}  // namespace octiso

@@ -1,0 +1,49 @@
+// The default framing of a data box and the camera checks of CONVENTIONS 2.
+#include <algorithm>
+#include <cmath>
+
+#include "math/vec.h"
+#include "octiso/camera.h"
+#include "octiso/error.h"
+
+namespace octiso {
+
+Camera frame_data_box(Dims dims, const Placement& placement, int width, int height) {
+    std::array<double, 3> lo, hi, centre;
+    double radius2 = 0;
+    for (int a = 0; a < 3; ++a) {
+        const uint32_t n = a == 0 ? dims.x : a == 1 ? dims.y : dims.z;
+        lo[a] = placement.origin[a];
+        hi[a] = placement.origin[a] + double(n > 0 ? n - 1 : 0) * placement.spacing[a];
+        centre[a] = 0.5 * (lo[a] + hi[a]);
+        radius2 += 0.25 * (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    }
+    const double radius = std::max(std::sqrt(radius2), 1e-9);
+    Camera c;
+    c.width = width;
+    c.height = height;
+    c.fov_deg = 35.0;
+    // A three-quarter view from +x, -y, +z with z up, far enough that the bounding sphere fits
+    // the narrower of the two fields of view.
+    const Vec3 view = vec_normalized({0.9, -1.3, 0.8});
+    const double half_fov = radians_from_degrees(c.fov_deg * 0.5);
+    const double aspect = double(width) / double(height);
+    const double narrow = aspect < 1 ? std::atan(std::tan(half_fov) * aspect) : half_fov;
+    const double distance = radius / std::sin(narrow) * 1.02;
+    for (int a = 0; a < 3; ++a) c.eye[a] = centre[a] + view[a] * distance;
+    c.look = centre;
+    c.up = {0, 0, 1};
+    return c;
+}
+
+void validate_camera(const Camera& camera) {
+    if (camera.width < 1 || camera.height < 1) throw Error("--size", "width and height must be positive");
+    if (!(camera.fov_deg > 0 && camera.fov_deg < 180)) throw Error("--fov", "must lie in (0, 180) degrees");
+    const Vec3 f = vec_sub(camera.look, camera.eye);
+    if (!(vec_dot(f, f) > 0)) throw Error("--look", "must differ from --eye");
+    const Vec3 side = vec_cross(f, camera.up);
+    if (!(vec_dot(side, side) > 1e-24 * vec_dot(f, f) * std::max(vec_dot(camera.up, camera.up), 1e-300)))
+        throw Error("--up", "must not be parallel to the viewing direction (or zero)");
+}
+
+}  // namespace octiso

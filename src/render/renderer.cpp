@@ -1,0 +1,235 @@
+// The persistent Renderer: per octree, the traversal set-up for the chosen scalar type and root
+// finder, the Embree device and scene (created once, re-pointed when options change) and the
+// thread arena; per frame, one primary ray per pixel through the one tile loop (tile_loop.h),
+// then shading and the AOVs. Policies (scalar type x root finder) are chosen once per frame by
+// a visit over the tracer variant, so the per-ray code is one inlined instantiation. What a
+// frame does not ask for is not computed: no normals unless colour or the normal AOV is wanted,
+// no shading without colour.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <variant>
+
+#include <tbb/task_arena.h>
+
+#include "octiso/error.h"
+#include "octiso/render.h"
+#include "render/pinhole_camera.h"
+#include "render/shade.h"
+#include "render/tile_loop.h"
+#include "render/traverse.h"
+#include "scene/embree_scene.h"
+
+namespace octiso {
+
+void validate_options(const RenderOptions& options, const RenderLimits& limits) {
+    if (options.isovalues.empty()) throw Error("--iso", "at least one isovalue is needed");
+    if (int(options.isovalues.size()) > kMaxIsovalues)
+        throw Error("--iso", "at most " + std::to_string(kMaxIsovalues) + " isovalues at once");
+    for (double v : options.isovalues)
+        if (!std::isfinite(v)) throw Error("--iso", "isovalues must be finite");
+    if (limits.iso_range) {
+        const auto [lo, hi] = *limits.iso_range;
+        for (double iso : options.isovalues)
+            if (!(iso > lo && iso < hi))
+                throw Error("--iso", "isovalue " + std::to_string(iso) + " lies outside the file's iso-range (" +
+                                         std::to_string(lo) + ", " + std::to_string(hi) +
+                                         "): the data there was clamped when " + limits.source + " was converted");
+    }
+    if (options.tile_size < 0) throw Error("tile_size", "must not be negative");
+}
+
+struct Renderer::Impl {
+    virtual ~Impl() = default;
+    virtual void set_options(const RenderOptions& options) = 0;
+    virtual RenderStats render_tiles(const Camera& camera, std::span<const int> tiles, bool all, Frame& frame) const = 0;
+    virtual ScalarType type() const = 0;
+    RenderOptions options;
+    RenderLimits limits;
+    std::unique_ptr<tbb::task_arena> arena;   ///< only when options.threads > 0
+
+    void adopt(const RenderOptions& o) {
+        validate_options(o, limits);
+        if (o.threads != options.threads || (o.threads > 0 && !arena)) {
+            arena.reset();
+            if (o.threads > 0) arena = std::make_unique<tbb::task_arena>(o.threads);
+        }
+        options = o;
+    }
+    template <class F> decltype(auto) in_arena(F&& f) const { return arena ? arena->execute(f) : f(); }
+};
+
+namespace {
+
+template <typename T> using TracerVariant =
+    std::variant<OctreeTracer<T, Neubauer>, OctreeTracer<T, Schwarze>, OctreeTracer<T, Linear>, OctreeTracer<T, Exact>>;
+
+/// Pixels of `rect` into `frame`: one run of up to kPacket pixels of a row per Embree call.
+template <class Tracer>
+void trace_rect(const Tracer& tracer, const EmbreeVolumeScene* scene, const PinholeCamera& pinhole,
+                const RenderOptions& options, const PixelRect& rect, Frame& frame, TileCounters& counters) {
+    constexpr int kPacket = EmbreeVolumeScene::kPacket;
+    const bool want_normal = options.want_colour || options.want_normal;
+    const SrgbTable& to_srgb8 = SrgbTable::instance();
+    const int W = frame.width;
+    Ray rays[kPacket];
+    TraceHit traced[kPacket];
+    for (int py = rect.y0; py < rect.y1; ++py)
+        for (int x0 = rect.x0; x0 < rect.x1; x0 += kPacket) {
+            const int count = std::min(kPacket, rect.x1 - x0);
+            for (int k = 0; k < count; ++k) rays[k] = pinhole.ray(x0 + k, py);
+            if (scene) scene->intersect_packet(rays, count, want_normal, traced);
+            else for (int k = 0; k < count; ++k) traced[k] = tracer.trace(rays[k], want_normal);
+            for (int k = 0; k < count; ++k) {
+                const TraceHit& hit = traced[k];
+                const size_t i = size_t(py) * W + size_t(x0 + k);
+                counters.hits += hit.is_hit();
+                if (options.want_depth) frame.depth[i] = float(hit.t);
+                if (options.want_normal)
+                    for (int a = 0; a < 3; ++a) frame.normal[3 * i + a] = hit.is_hit() ? float(hit.normal[a]) : 0.0f;
+                if (options.want_colour) shade_pixel(to_srgb8, hit, rays[k].dir, &frame.rgb[3 * i]);
+            }
+        }
+    counters.rays += uint64_t(rect.x1 - rect.x0) * uint64_t(rect.y1 - rect.y0);
+}
+
+template <typename T> class TypedRenderer final : public Renderer::Impl {
+public:
+    TypedRenderer(const Octree<T>& tree, const Placement& placement) : tree_(tree), placement_(placement) {}
+
+    ScalarType type() const override { return scalar_type_of<T>(); }
+
+    void set_options(const RenderOptions& o) override {
+        adopt(o);
+        dispatch_root_finder(o.root_finder, o.iterations, [&](const auto& finder) {
+            using Tracer = OctreeTracer<T, std::decay_t<decltype(finder)>>;
+            const Tracer& tracer = tracer_.template emplace<Tracer>(tree_, placement_, o.isovalues.data(),
+                                                                    int(o.isovalues.size()), finder);
+            const EmbreeVolumeScene::TraceFn trace = [](const void* user, const Ray& ray, bool normal) {
+                return static_cast<const Tracer*>(user)->trace(ray, normal);
+            };
+            if (!o.use_embree) return;
+            if (!scene_) {
+                scene_ = std::make_unique<EmbreeVolumeScene>();
+                scene_->add_volume(data_box_lo(), data_box_hi(), &tracer, trace);
+                scene_->commit();
+            } else {
+                scene_->set_volume_trace(0, &tracer, trace);
+            }
+        });
+    }
+
+    RenderStats render_tiles(const Camera& camera, std::span<const int> tiles, bool all, Frame& frame) const override {
+        const PinholeCamera pinhole(camera);
+        const TileGrid grid = tile_grid_for(camera.width, camera.height, options.tile_size);
+        const EmbreeVolumeScene* scene = options.use_embree ? scene_.get() : nullptr;
+        return in_arena([&] {
+            return std::visit(
+                [&](const auto& tracer) {
+                    return for_each_tile(grid, tiles, all, [&](const PixelRect& rect, TileCounters& counters) {
+                        trace_rect(tracer, scene, pinhole, options, rect, frame, counters);
+                    });
+                },
+                tracer_);
+        });
+    }
+
+private:
+    // The data box in world space, [origin, origin + (n-1) * spacing] per axis (either order).
+    std::array<double, 3> data_box_lo() const { return data_box_corner(true); }
+    std::array<double, 3> data_box_hi() const { return data_box_corner(false); }
+    std::array<double, 3> data_box_corner(bool lower) const {
+        const Dims d = tree_.dims();
+        const uint32_t n[3] = {d.x, d.y, d.z};
+        std::array<double, 3> c;
+        for (int a = 0; a < 3; ++a) {
+            const double e0 = placement_.origin[a], e1 = placement_.origin[a] + double(n[a] - 1) * placement_.spacing[a];
+            c[a] = lower ? std::min(e0, e1) : std::max(e0, e1);
+        }
+        return c;
+    }
+
+    const Octree<T> tree_;
+    const Placement placement_;
+    // The tracer the scene's user geometry points at: it lives here, so its address is stable
+    // until the next set_options(), which re-points the scene.
+    TracerVariant<T> tracer_{std::in_place_index<0>, tree_, placement_, nullptr, 0, Neubauer{}};
+    std::unique_ptr<EmbreeVolumeScene> scene_;
+};
+
+}  // namespace
+
+template <typename T>
+Renderer::Renderer(const Octree<T>& tree, const Placement& placement, const RenderOptions& options,
+                   const RenderLimits& limits) {
+    auto impl = std::make_unique<TypedRenderer<T>>(tree, placement);
+    impl->limits = limits;
+    impl->set_options(options);
+    impl_ = std::move(impl);
+}
+
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+void Renderer::set_options(const RenderOptions& options) { impl_->set_options(options); }
+const RenderOptions& Renderer::options() const { return impl_->options; }
+ScalarType Renderer::type() const { return impl_->type(); }
+
+TileGrid Renderer::tile_grid(int width, int height) const {
+    return tile_grid_for(width, height, impl_->options.tile_size);
+}
+
+void Renderer::prepare_frame(const Camera& camera, Frame& frame) const {
+    validate_camera(camera);
+    const RenderOptions& o = impl_->options;
+    const size_t pixels = size_t(camera.width) * size_t(camera.height);
+    frame.width = camera.width;
+    frame.height = camera.height;
+    // Every pixel of a traced tile is written, so reused buffers need no clearing.
+    frame.rgb.resize(o.want_colour ? pixels * 3 : 0);
+    frame.depth.resize(o.want_depth ? pixels : 0);
+    frame.normal.resize(o.want_normal ? pixels * 3 : 0);
+    frame.stats = {};
+}
+
+RenderStats Renderer::render(const Camera& camera, Frame& frame) const {
+    prepare_frame(camera, frame);
+    frame.stats = impl_->render_tiles(camera, {}, true, frame);
+    return frame.stats;
+}
+
+Frame Renderer::render(const Camera& camera) const {
+    Frame frame;
+    render(camera, frame);
+    return frame;
+}
+
+RenderStats Renderer::render_tiles(const Camera& camera, std::span<const int> tiles, Frame& frame) const {
+    validate_camera(camera);
+    const RenderOptions& o = impl_->options;
+    const size_t pixels = size_t(camera.width) * size_t(camera.height);
+    if (frame.width != camera.width || frame.height != camera.height || frame.rgb.size() != (o.want_colour ? pixels * 3 : 0) ||
+        frame.depth.size() != (o.want_depth ? pixels : 0) || frame.normal.size() != (o.want_normal ? pixels * 3 : 0))
+        throw Error("render_tiles", "the frame was not prepared for this camera and these options (prepare_frame)");
+    const int count = tile_grid(camera.width, camera.height).count();
+    for (int t : tiles)
+        if (t < 0 || t >= count)
+            throw Error("render_tiles", "tile " + std::to_string(t) + " outside 0.." + std::to_string(count - 1));
+    return impl_->render_tiles(camera, tiles, false, frame);
+}
+
+template <typename T>
+Frame render(const Octree<T>& tree, const Placement& placement, const Camera& camera, const RenderOptions& options) {
+    validate_options(options);
+    validate_camera(camera);
+    return Renderer(tree, placement, options).render(camera);
+}
+
+#define OCTISO_INSTANTIATE(T)                                                                                       \
+    template Renderer::Renderer(const Octree<T>&, const Placement&, const RenderOptions&, const RenderLimits&);    \
+    template Frame render<T>(const Octree<T>&, const Placement&, const Camera&, const RenderOptions&);
+OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
+#undef OCTISO_INSTANTIATE
+
+}  // namespace octiso

@@ -1,0 +1,50 @@
+// The one tile loop: every frame (the renderer's and the references') is cut into a TileGrid and
+// its tiles are handed to TBB one by one (simple partitioner, work stealing). The caller's
+// task_arena decides the thread count. Per tile, `body(rect, stats)` traces the pixels of `rect`
+// into plain local counters, folded into the shared ones once per tile (no shared atomics per ray).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <span>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "octiso/frame.h"
+#include "octiso/tiles.h"
+
+namespace octiso {
+
+struct TileCounters {
+    uint64_t rays = 0, hits = 0;
+};
+
+/// Runs body(const PixelRect&, TileCounters&) for the tiles `tiles` of `grid` (all tiles when
+/// `all`), in parallel; returns the wall time and the summed counters.
+template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<const int> tiles, bool all, Body&& body) {
+    std::atomic<uint64_t> rays{0}, hits{0};
+    const int n = all ? grid.count() : int(tiles.size());
+    const auto t0 = std::chrono::steady_clock::now();
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, n, 1),
+        [&](const tbb::blocked_range<int>& range) {
+            for (int i = range.begin(); i < range.end(); ++i) {
+                TileCounters local;
+                body(grid.rect(all ? i : tiles[size_t(i)]), local);
+                rays += local.rays;
+                hits += local.hits;
+            }
+        },
+        tbb::simple_partitioner());
+    RenderStats stats;
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stats.rays = rays;
+    stats.hits = hits;
+    stats.threads = tbb::this_task_arena::max_concurrency();
+    return stats;
+}
+
+}  // namespace octiso
