@@ -15,8 +15,20 @@ struct Camera {
     int width = 512, height = 512;
 };
 
-/// A camera that frames the data box of `dims` placed by `placement` from a three-quarter view.
+/// A camera that frames the data box of `dims` placed by `placement` from a three-quarter view
+/// (orbit_camera at kDefaultAzimuthDeg, kDefaultElevationDeg, zoom 1).
 Camera frame_data_box(Dims dims, const Placement& placement, int width, int height);
+
+/// The three-quarter view of frame_data_box: from +x, -y, +z (direction 0.9, -1.3, 0.8) with z up.
+inline constexpr double kDefaultAzimuthDeg = -55.30484646876604;    // atan2(-1.3, 0.9)
+inline constexpr double kDefaultElevationDeg = 26.837787558336064;  // asin(0.8 / |(0.9, -1.3, 0.8)|)
+
+/// A camera on a sphere around the centre of the data box, looking at the centre with z up:
+/// azimuth in degrees counter-clockwise from +x in the xy plane, elevation in degrees above it
+/// (|elevation| < 90), at the distance where the box's bounding sphere fills the narrower field
+/// of view, divided by `zoom` (> 0). frame_data_box is this at the default angles and zoom 1.
+Camera orbit_camera(Dims dims, const Placement& placement, int width, int height, double azimuth_deg,
+                    double elevation_deg, double zoom = 1.0);
 
 /// Throws Error(flag, ...) unless the camera defines a ray for every pixel: positive size, fov in
 /// (0, 180), look != eye, up not parallel to the view direction.

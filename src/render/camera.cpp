@@ -8,7 +8,12 @@
 
 namespace octiso {
 
-Camera frame_data_box(Dims dims, const Placement& placement, int width, int height) {
+namespace {
+
+/// The camera looking at the data box's centre from unit direction `view` (centre -> eye), z up,
+/// far enough that the box's bounding sphere fits the narrower of the two fields of view, divided
+/// by `zoom`.
+Camera camera_towards_box(Dims dims, const Placement& placement, int width, int height, const Vec3& view, double zoom) {
     std::array<double, 3> lo, hi, centre;
     double radius2 = 0;
     for (int a = 0; a < 3; ++a) {
@@ -23,17 +28,31 @@ Camera frame_data_box(Dims dims, const Placement& placement, int width, int heig
     c.width = width;
     c.height = height;
     c.fov_deg = 35.0;
-    // A three-quarter view from +x, -y, +z with z up, far enough that the bounding sphere fits
-    // the narrower of the two fields of view.
-    const Vec3 view = vec_normalized({0.9, -1.3, 0.8});
     const double half_fov = radians_from_degrees(c.fov_deg * 0.5);
     const double aspect = double(width) / double(height);
     const double narrow = aspect < 1 ? std::atan(std::tan(half_fov) * aspect) : half_fov;
-    const double distance = radius / std::sin(narrow) * 1.02;
+    const double distance = radius / std::sin(narrow) * 1.02 / zoom;
     for (int a = 0; a < 3; ++a) c.eye[a] = centre[a] + view[a] * distance;
     c.look = centre;
     c.up = {0, 0, 1};
     return c;
+}
+
+}  // namespace
+
+Camera frame_data_box(Dims dims, const Placement& placement, int width, int height) {
+    // The vector itself, not its angles: cos/sin of kDefault*Deg would move the eye by an ulp.
+    return camera_towards_box(dims, placement, width, height, vec_normalized({0.9, -1.3, 0.8}), 1.0);
+}
+
+Camera orbit_camera(Dims dims, const Placement& placement, int width, int height, double azimuth_deg,
+                    double elevation_deg, double zoom) {
+    if (!std::isfinite(azimuth_deg)) throw Error("--azimuth", "must be a finite number of degrees");
+    if (!(std::fabs(elevation_deg) < 90)) throw Error("--elevation", "must lie in (-90, 90) degrees (z is up)");
+    if (!(zoom > 0) || !std::isfinite(zoom)) throw Error("--zoom", "must be a positive number");
+    const double az = radians_from_degrees(azimuth_deg), el = radians_from_degrees(elevation_deg);
+    const Vec3 view{std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+    return camera_towards_box(dims, placement, width, height, view, zoom);
 }
 
 void validate_camera(const Camera& camera) {
