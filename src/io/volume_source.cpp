@@ -1,7 +1,7 @@
-// LoadedVolume's constructor, format names and detection (extension first, then magic bytes), and
-// open_volume(): the one entry point the converter uses to turn a path and the raw/placement
-// flags of CONVENTIONS 3 into a checked LoadedVolume. The readers themselves live in
-// raw_reader.cpp and vtk_reader.cpp.
+// Format detection (extension first, then magic bytes) and open_volume(): the one entry point the
+// converter uses to turn a path and the raw/placement flags of CONVENTIONS 3 into a checked
+// LoadedVolume. The readers themselves live in raw_reader.cpp and vtk_reader.cpp; LoadedVolume's
+// constructor and the format names live in the core (src/volume/loaded_volume.cpp).
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -14,24 +14,6 @@
 #include "octiso/reader.h"
 
 namespace octiso {
-
-LoadedVolume::LoadedVolume(std::shared_ptr<const void> owner, const std::byte* data, ScalarType type, Dims dims,
-                           Placement placement, bool swap_bytes, std::string source, VolumeFormat format)
-    : owner_(std::move(owner)), data_(data), type_(type), dims_(dims), placement_(placement),
-      swap_bytes_(swap_bytes), source_(std::move(source)), format_(format) {}
-
-std::string_view volume_format_name(VolumeFormat f) {
-    switch (f) {
-        case VolumeFormat::raw: return "raw";
-        case VolumeFormat::nifti: return "NIfTI";
-        case VolumeFormat::vti: return "VTK XML image data";
-        case VolumeFormat::legacy_vtk: return "legacy VTK";
-        case VolumeFormat::meta_image: return "MetaImage";
-        case VolumeFormat::nrrd: return "NRRD";
-        case VolumeFormat::synthetic: return "synthetic";
-    }
-    return "unknown";
-}
 
 namespace io {
 

@@ -7,11 +7,18 @@
 #include <iostream>
 
 #include "octiso/error.h"
+#include "octiso/version.h"
 
 namespace octiso::cli {
 
 int run_main(const char* tool, int argc, char** argv, const std::function<int(std::vector<std::string>&)>& body) {
     std::vector<std::string> args(argv + 1, argv + argc);
+    // --version anywhere wins over everything else, as in the GNU tools.
+    for (const std::string& a : args)
+        if (a == "--version") {
+            std::cout << tool << " " << OCTISO_VERSION_STRING << "\n";
+            return 0;
+        }
     try {
         return body(args);
     } catch (const Error& e) {

@@ -13,7 +13,8 @@
 namespace octiso::cli {
 
 /// Runs body(args without argv[0]); prints "TOOL: SUBJECT: PROBLEM" for an octiso::Error and
-/// returns its exit status (2 bad input/usage, 1 other); any other exception gives 1.
+/// returns its exit status (2 bad input/usage, 1 other); any other exception gives 1. With
+/// --version among the arguments it prints "TOOL VERSION" on stdout and returns 0 instead.
 int run_main(const char* tool, int argc, char** argv, const std::function<int(std::vector<std::string>&)>& body);
 
 /// Flags are "--name value" or "--name=value"; everything not starting with "--" (or "-o") is
