@@ -85,8 +85,8 @@ public:
     /// What the renderer must refuse: the iso-range recorded at build or in the file, naming the
     /// file (or the build's source name).
     RenderLimits render_limits() const;
-    /// A persistent Renderer over this octree with render_limits(). The Renderer reads the
-    /// octree's storage: keep this AnyOctree (or a copy) alive as long as the Renderer.
+    /// A persistent Renderer over this octree with render_limits(). It shares ownership of the
+    /// octree's storage (Renderer::keep_alive), so it may outlive this handle.
     Renderer make_renderer(const RenderOptions& options) const;
     /// One frame in one call (make_renderer(options).render(camera)). Throws Error on bad options
     /// or camera.

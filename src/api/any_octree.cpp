@@ -192,7 +192,9 @@ void AnyOctree::save(const std::string& path) const {
 RenderLimits AnyOctree::render_limits() const { return RenderLimits{impl_->iso_range, impl_->source}; }
 
 Renderer AnyOctree::make_renderer(const RenderOptions& options) const {
-    return impl_->make_renderer(options, render_limits());
+    Renderer renderer = impl_->make_renderer(options, render_limits());
+    renderer.keep_alive(impl_);   // the tree's arrays (or the file's mapping) live in *impl_
+    return renderer;
 }
 
 Frame AnyOctree::render(const Camera& camera, const RenderOptions& options) const {

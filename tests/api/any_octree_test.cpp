@@ -102,8 +102,9 @@ TYPED_TEST(AnyOctreeTyped, BuildSaveOpenRenderEqualsTheTypedPath) {
     EXPECT_EQ(opened.file()->info().step_count, 1u);
     expect_same_arrays(*opened.as<T>(), typed.view());
     expect_identical_frames(opened.render(camera, options), expected);
-    // A persistent renderer gives the same frame twice, and again after new options.
-    const Renderer renderer = opened.make_renderer(options);
+    // A persistent renderer gives the same frame twice, and keeps the file mapped after every
+    // AnyOctree handle of it is gone.
+    const Renderer renderer = AnyOctree::open(path).make_renderer(options);
     expect_identical_frames(renderer.render(camera), expected);
     expect_identical_frames(renderer.render(camera), expected);
 }
