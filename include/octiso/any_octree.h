@@ -5,7 +5,8 @@
 // (build.h, oct_file.h, render.h) stays the place for code that knows its T.
 //
 // Ownership: copies share one immutable octree (shared ownership of the built arrays or of the
-// mapped file), so a step handed out stays valid however long the caller keeps it.
+// mapped file), so a step handed out stays valid however long the caller keeps it. Every const
+// method may be called from several threads at once.
 #pragma once
 
 #include <array>

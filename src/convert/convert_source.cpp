@@ -1,6 +1,7 @@
 // ConvertSource (include/octiso/convert.h): the five kinds of input octiso-convert accepts and
 // how step i of each is named and opened. Reading itself is reader.h and synthetic.h; this file
 // only chooses which of them to call and applies the placement overrides to generated steps.
+#include <cstdint>
 #include <utility>
 
 #include "octiso/convert.h"
@@ -26,7 +27,7 @@ ConvertSource ConvertSource::files(std::vector<std::string> paths, RawOptions ra
 }
 
 ConvertSource ConvertSource::pattern(std::string pattern, long long first, long long last, RawOptions raw) {
-    if (first < 0 || last < first || last - first >= (1LL << 32))
+    if (first < 0 || last < first || last - first >= (long long)UINT32_MAX)   // the count must fit 32 bits
         throw Error("--steps", "expected A:B with 0 <= A <= B, found " + std::to_string(first) + ":" + std::to_string(last));
     format_step(pattern, first, "--steps");   // the pattern is checked before any I/O
     ConvertSource s;
