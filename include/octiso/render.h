@@ -44,7 +44,7 @@ struct RenderLimits {
 class Renderer {
 public:
     /// Prepares rendering `tree` placed in the world by `placement`. The octree's storage (an
-    /// OctreeData or a mapped OctFile) must outlive the Renderer. Throws Error on bad options
+    /// OctreeData or a mapped OctFile) must outlive the Renderer, or be handed to keep_alive(). Throws Error on bad options
     /// (set_options) or when Embree cannot be set up.
     template <typename T>
     Renderer(const Octree<T>& tree, const Placement& placement, const RenderOptions& options,
@@ -58,6 +58,10 @@ public:
     void set_options(const RenderOptions& options);
     const RenderOptions& options() const;
     ScalarType type() const;
+
+    /// Shares ownership of `storage`, whatever holds the octree's arrays (AnyOctree passes its
+    /// own), so the Renderer stays valid however long it is kept. Optional for typed callers.
+    void keep_alive(std::shared_ptr<const void> storage);
 
     /// The tiles a frame of width x height is cut into under these options.
     TileGrid tile_grid(int width, int height) const;

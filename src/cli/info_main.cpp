@@ -7,6 +7,7 @@
 #include <cstring>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <vector>
 
@@ -14,7 +15,7 @@
 #include "cli/common/json.h"
 #include "format/oct_layout.h"
 #include "io/atomic_output.h"
-#include "octiso/decode.h"
+#include "octiso/any_octree.h"
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
 
@@ -32,31 +33,26 @@ struct Extract {
     uint64_t bytes = 0;
 };
 
-/// Decodes step `k` and writes it x-fastest through AtomicOutput, byte-swapped if asked.
-void extract_raw(const OctFile& file, Extract& ex) {
-    const OctInfo& info = file.info();
-    ex.bytes = checked_volume_bytes(info.dims, info.type, file.path());
+/// Decodes step `ex.step` and writes it x-fastest through AtomicOutput, byte-swapped if asked.
+void extract_raw(const std::shared_ptr<const OctFile>& file, Extract& ex) {
+    const OctInfo& info = file->info();
+    ex.bytes = checked_volume_bytes(info.dims, info.type, file->path());
     // The dense array is decoded in memory: refuse up front, naming the size, rather than fail
     // on allocation (a sparse 16384^3 octree is 98 KB on disk and 16 TiB as an array).
     const uint64_t memory = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
     if (ex.bytes > memory)
-        throw Error("--extract-raw", "step " + std::to_string(ex.step) + " of " + file.path() + " is " +
+        throw Error("--extract-raw", "step " + std::to_string(ex.step) + " of " + file->path() + " is " +
                                          std::to_string(ex.bytes) + " bytes as a dense array, more than this machine's " +
                                          std::to_string(memory) + " bytes of memory");
-    dispatch_scalar_type(info.type, [&](auto t) {
-        using T = decltype(t);
-        const Octree<T> tree = file.step<T>(ex.step);
-        std::vector<T> data(size_t(info.dims.voxels()));
-        decode_to_dense(tree, data.data());
-        if (ex.big_endian)
-            for (T& v : data) v = VolumeView<T>::byte_swapped(v);
-        AtomicOutput out(ex.path);
-        std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");
-        if (!f) throw Error(out.temp_path(), std::string("cannot create: ") + std::strerror(errno), ErrorKind::Other);
-        const bool ok = std::fwrite(data.data(), 1, size_t(ex.bytes), f) == size_t(ex.bytes);
-        if (std::fclose(f) != 0 || !ok) throw Error(ex.path, "write failed", ErrorKind::Other);
-        out.commit();
-    });
+    const AnyOctree step = AnyOctree::step(file, ex.step);
+    std::vector<std::byte> data(size_t(ex.bytes));
+    step.decode(data, ex.big_endian ? std::endian::big : std::endian::little);
+    AtomicOutput out(ex.path);
+    std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");
+    if (!f) throw Error(out.temp_path(), std::string("cannot create: ") + std::strerror(errno), ErrorKind::Other);
+    const bool ok = std::fwrite(data.data(), 1, size_t(ex.bytes), f) == size_t(ex.bytes);
+    if (std::fclose(f) != 0 || !ok) throw Error(ex.path, "write failed", ErrorKind::Other);
+    out.commit();
 }
 
 std::string join(const std::vector<uint64_t>& v) {
@@ -182,14 +178,15 @@ int main(int argc, char** argv) {
             }
         }
 
-        const OctFile file = OctFile::open(files[0], Verify::Full);
+        const auto shared_file = std::make_shared<const OctFile>(OctFile::open(files[0], Verify::Full));
+        const OctFile& file = *shared_file;
         if (extract_path && ex.step >= file.info().step_count)
             throw Error("--step", "step " + std::to_string(ex.step) + " does not exist in " + files[0] +
                                       " (expected 0 .. " + std::to_string(file.info().step_count - 1) + ")");
         std::vector<StepSizes> steps;
         steps.reserve(file.info().step_count);
         for (uint32_t k = 0; k < file.info().step_count; ++k) steps.push_back(file.step_sizes(k));
-        if (extract_path) extract_raw(file, ex);
+        if (extract_path) extract_raw(shared_file, ex);
 
         const Extract* exp = extract_path ? &ex : nullptr;
         if (json) {

@@ -10,6 +10,7 @@
 
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
+#include "octiso/any_octree.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
 #include "octiso/oct_file.h"
@@ -73,8 +74,8 @@ int run(std::vector<std::string>& argv) {
     if (iterations) options.iterations = int(cli::parse_int(*iterations, "--iterations", 0, 1000));
 
     // Everything about the outputs is checked before the first frame is rendered.
-    const OctFile file = OctFile::open(inputs[0]);
-    const OctInfo& info = file.info();
+    const auto file = std::make_shared<const OctFile>(OctFile::open(inputs[0]));
+    const OctInfo& info = file->info();
     long long first = 0, last = 0;
     if (steps) {
         const auto range = cli::parse_steps(*steps, "--steps");
@@ -117,11 +118,10 @@ int run(std::vector<std::string>& argv) {
     Progress progress(last - first + 1);
     double total_seconds = 0;
     for (long long k = first; k <= last; ++k) {
+        // One Renderer per step; the Embree device behind it is shared by the whole process.
         Frame frame;
-        dispatch_scalar_type(info.type, [&](auto tag) {
-            using T = decltype(tag);
-            Renderer(file.step<T>(uint32_t(k)), info.placement, options, limits).render(camera, frame);
-        });
+        const AnyOctree step = AnyOctree::step(file, uint32_t(k));
+        step.make_renderer(options).render(camera, frame);
         if (out_path) write_colour_image(name_for(out_path, "-o", k), frame);
         if (depth_path) write_depth_image(name_for(depth_path, "--depth", k), frame);
         if (normal_path) write_normal_image(name_for(normal_path, "--normal", k), frame);

@@ -47,6 +47,7 @@ struct Renderer::Impl {
     RenderOptions options;
     RenderLimits limits;
     std::unique_ptr<tbb::task_arena> arena;   ///< only when options.threads > 0
+    std::shared_ptr<const void> storage;      ///< keep_alive(): the octree's arrays, if shared
 
     void adopt(const RenderOptions& o) {
         validate_options(o, limits);
@@ -174,6 +175,7 @@ Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
 void Renderer::set_options(const RenderOptions& options) { impl_->set_options(options); }
 const RenderOptions& Renderer::options() const { return impl_->options; }
+void Renderer::keep_alive(std::shared_ptr<const void> storage) { impl_->storage = std::move(storage); }
 ScalarType Renderer::type() const { return impl_->type(); }
 
 TileGrid Renderer::tile_grid(int width, int height) const {

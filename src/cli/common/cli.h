@@ -10,6 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include "octiso/step_pattern.h"
+
 namespace octiso::cli {
 
 /// Runs body(args without argv[0]); prints "TOOL: SUBJECT: PROBLEM" for an octiso::Error and
@@ -44,8 +46,7 @@ std::array<int, 2> parse_size(std::string_view text, const std::string& flag);  
 std::array<long long, 2> parse_steps(std::string_view text, const std::string& flag); ///< A:B inclusive
 std::vector<double> parse_list(std::string_view text, const std::string& flag);      ///< V1,V2,...
 
-/// Expands the one printf integer field of `pattern` (e.g. frame_%04d.png) with k; throws
-/// Error(flag, ...) unless the pattern holds exactly one %d-style field.
-std::string format_step(const std::string& pattern, long long k, const std::string& flag);
+/// Series names (frame_%04d.png): the library's expansion, octiso/step_pattern.h.
+using octiso::format_step;
 
 }  // namespace octiso::cli

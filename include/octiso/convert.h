@@ -1,0 +1,107 @@
+// The conversion pipeline behind octiso-convert: volumes (one file, a list of files, a printf
+// pattern over steps A..B, a synthetic generator, or the sparse-spheres field built directly as
+// an octree) -> one .oct file. Every step is opened and checked against the first before
+// anything is written; steps are then built and streamed into OctWriter one at a time, so memory
+// stays near one input plus one octree. The caller gets a report to print; nothing here prints.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "octiso/build.h"
+#include "octiso/oct_file.h"
+#include "octiso/reader.h"
+#include "octiso/synthetic.h"
+#include "octiso/volume.h"
+
+namespace octiso {
+
+/// Where the steps of a conversion come from. Built by the factories below; immutable after.
+class ConvertSource {
+public:
+    /// One input file (any format open_volume() reads), one step.
+    static ConvertSource file(std::string path, RawOptions raw = {});
+    /// Several input files, step i from paths[i] (at least one).
+    static ConvertSource files(std::vector<std::string> paths, RawOptions raw = {});
+    /// Steps first..last (inclusive) from `pattern` with one printf integer field (t_%03d.raw).
+    /// Checks the pattern now: throws Error("--steps", ...) unless it holds exactly one %d field.
+    static ConvertSource pattern(std::string pattern, long long first, long long last, RawOptions raw = {});
+    /// A generator of synthetic.h, parsed from `spec` (NAME:N, NAME:NX,NY,NZ, plume-series:N,STEPS);
+    /// `type` overrides the generator's type; raw.spacing / raw.origin override its placement
+    /// (the other raw options do not apply). Throws Error("--synthetic", ...) for a bad spec.
+    static ConvertSource synthetic(const std::string& spec, std::optional<ScalarType> type = {}, RawOptions raw = {});
+    /// sparse-spheres:N (f32, N^3), built as an octree with no dense array (sparse_synthetic.h).
+    static ConvertSource sparse_spheres(uint32_t n);
+
+    /// What reports call the input: the file, the pattern, the first of a list, or the spec.
+    const std::string& name() const { return name_; }
+    uint32_t step_count() const;
+    bool is_synthetic() const { return synthetic_.has_value(); }
+    bool is_sparse_spheres() const { return sparse_n_ != 0; }
+    uint32_t sparse_spheres_n() const { return sparse_n_; }
+    /// The file of step i (list entry or expanded pattern); name() for a single file.
+    std::string step_path(uint32_t i) const;
+    /// Opens (or generates) step i, placement overrides applied. Throws Error naming the file.
+    /// Not for sparse-spheres, which has no dense volume.
+    LoadedVolume load(uint32_t i) const;
+
+private:
+    ConvertSource() = default;
+    std::string name_;
+    std::vector<std::string> list_;                 // several files: step i is list_[i]
+    std::optional<std::array<long long, 2>> steps_; // a pattern over steps_[0]..steps_[1]
+    std::optional<SyntheticSpec> synthetic_;
+    std::optional<ScalarType> synthetic_type_;
+    uint32_t sparse_n_ = 0;
+    RawOptions raw_;
+};
+
+/// What one step cost and gave.
+struct ConvertStepReport {
+    std::string source;          ///< the step's file or synthetic name
+    StepSizes sizes;             ///< nodes and scalar leaves per depth, section bytes
+    double build_seconds = 0;    ///< the octree build alone
+};
+
+/// What a conversion did, for the tool's text and JSON reports (sizes in bytes, times in seconds).
+struct ConvertReport {
+    std::string input;           ///< ConvertSource::name()
+    std::string output;
+    VolumeFormat format = VolumeFormat::raw;   ///< of the first step
+    ScalarType type = ScalarType::u8;
+    Dims dims;
+    Placement placement;
+    int dmax = 0;
+    uint32_t steps = 0;
+    /// sparse-spheres: built directly as an octree; input_bytes, per_step timings and peak RSS
+    /// are then not measured (0).
+    bool built_directly = false;
+    std::optional<std::array<double, 2>> iso_range;
+    double tolerance = 0.0;
+    std::vector<ConvertStepReport> per_step;
+    StepSizes total;             ///< sums over all steps, per depth and per section kind
+    uint64_t input_bytes = 0;    ///< dense bytes of the first step times the step count
+    uint64_t file_bytes = 0;
+    double build_seconds = 0;    ///< sum of the steps' build_seconds
+    double total_seconds = 0;    ///< the whole call, reading and writing included
+    uint64_t peak_rss_bytes = 0; ///< the process's high-water mark when the file was finished
+    int threads = 0;             ///< TBB's parallelism limit during the call
+
+    double ratio() const { return input_bytes ? double(file_bytes) / double(input_bytes) : 0.0; }
+    double mvoxels_per_second() const {
+        return build_seconds > 0 ? double(dims.voxels()) * steps / build_seconds / 1e6 : 0.0;
+    }
+};
+
+/// Converts `source` into the .oct file `output` with `options` (iso_range, tolerance, nan_as,
+/// threads; source_name is set per step). Step 0 is opened and every other step checked
+/// against it (dims, type, spacing and origin) before the output is created; a mismatch throws
+/// Error(step file, ...) (exit 2) and writes nothing. Until the file is finished only a
+/// temporary sibling exists, removed on any error. options.threads > 0 limits all TBB work
+/// of the process to that many threads for the duration of the call (tbb::global_control).
+ConvertReport convert(const ConvertSource& source, const std::string& output, const BuildOptions& options);
+
+}  // namespace octiso

@@ -1,0 +1,28 @@
+// The same-grid check of a series (same_grid.h). Exact comparison of spacing and origin is
+// deliberate: the header stores them once, so any difference would misplace a step.
+#include "convert/same_grid.h"
+
+#include "octiso/error.h"
+
+namespace octiso::convert_detail {
+
+namespace {
+std::string dims_text(Dims d) { return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z); }
+}  // namespace
+
+GridOfStep::GridOfStep(const LoadedVolume& v)
+    : source(v.source()), format(v.format()), type(v.type()), dims(v.dims()), placement(v.placement()), bytes(v.bytes()) {}
+
+void check_same_grid(const GridOfStep& first, const LoadedVolume& v) {
+    if (v.dims() != first.dims)
+        throw Error(v.source(), "dims differ from the first step (expected " + dims_text(first.dims) + ", found " +
+                                    dims_text(v.dims()) + ")");
+    if (v.type() != first.type)
+        throw Error(v.source(), "scalar type differs from the first step (expected " +
+                                    std::string(scalar_type_name(first.type)) + ", found " +
+                                    std::string(scalar_type_name(v.type())) + ")");
+    if (v.placement().spacing != first.placement.spacing || v.placement().origin != first.placement.origin)
+        throw Error(v.source(), "spacing or origin differs from the first step (override both with --spacing/--origin)");
+}
+
+}  // namespace octiso::convert_detail

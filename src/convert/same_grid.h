@@ -1,0 +1,28 @@
+// The same-grid rule of a time series: every step must agree with the first in everything the
+// .oct header records once for all steps (dims, scalar type, spacing, origin). GridOfStep keeps
+// what the check and the report need from step 0 without keeping its voxels alive.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "octiso/reader.h"
+#include "octiso/volume.h"
+
+namespace octiso::convert_detail {
+
+struct GridOfStep {
+    std::string source;
+    VolumeFormat format = VolumeFormat::raw;
+    ScalarType type = ScalarType::u8;
+    Dims dims;
+    Placement placement;
+    uint64_t bytes = 0;   ///< dense voxel bytes
+    explicit GridOfStep(const LoadedVolume& v);
+};
+
+/// Throws Error(step.source(), ...) (bad input, exit 2) naming the first field that differs
+/// from step 0, with both values for dims and type.
+void check_same_grid(const GridOfStep& first, const LoadedVolume& step);
+
+}  // namespace octiso::convert_detail
