@@ -2,10 +2,17 @@
 // on 1..nproc threads at 512^2 and 1024^2, and the load-balance bound of the dynamic tile scheduler
 // on 1..64 workers: 8x8 blocks timed single-threaded, summed into tiles, list-scheduled in TBB's
 // split order (each worker takes the next tile when free: work stealing without overhead); speedup
-// = sum / makespan. A static split into P equal runs of tiles is shown for contrast.
+// = sum / makespan. A static split into P equal runs of tiles is shown for contrast. The model adds
+// what the pure schedule leaves out: the serial per-frame time of render() (measured: call time -
+// tile-loop time) and the machine's own ceiling (a compute-bound loop on 1..nproc threads, which
+// sees shared caches, clocks and other processes). Every simulated figure is labelled simulated.
 #include <time.h>
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
+#include <atomic>
 #include <fstream>
 #include <iostream>
 #include <queue>
@@ -80,6 +87,32 @@ double static_makespan(const std::vector<double>& cost, int workers) {
     return makespan;
 }
 
+/// The machine's ceiling: wall seconds of a compute-bound loop (8 independent FMA chains, no memory
+/// traffic) of fixed length per thread, run on `threads` threads at once in a task arena; the
+/// ceiling speedup at P is P * t(1) / t(P). Median of `repeats` runs.
+double compute_bound_seconds(int threads, int repeats) {
+    std::vector<double> s;
+    for (int r = 0; r < repeats; ++r) {
+        tbb::task_arena arena(threads);
+        std::atomic<double> sink{0};
+        const auto t0 = std::chrono::steady_clock::now();
+        arena.execute([&] {
+            tbb::parallel_for(0, threads, [&](int) {
+                double x[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+                for (int i = 0; i < 20'000'000; ++i)
+                    for (double& v : x) v = v * 0.999999 + 1e-7;
+                double sum = 0;
+                for (double v : x) sum += v;
+                sink = sink + sum;
+            }, tbb::static_partitioner());
+        });
+        s.push_back(seconds_since(t0));
+        if (sink.load() == -1.0) std::cerr << "";   // keep the loop observable
+    }
+    std::sort(s.begin(), s.end());
+    return s[s.size() / 2];
+}
+
 /// CPU seconds of the whole process (all threads, spinning workers included).
 double process_cpu_seconds() {
     timespec ts{};
@@ -107,8 +140,14 @@ struct Simulated {
     int width = 0, tile = 16;
     uint64_t tiles = 0;
     double sum_seconds = 0, max_tile_seconds = 0;
+    double serial_seconds = 0;   ///< measured per-frame serial time of render() at this size
     std::vector<int> workers;
     std::vector<double> dynamic_speedup, static_speedup;
+    /// (serial + sum) / (serial + makespan): the schedule with the serial per-frame work.
+    std::vector<double> serial_speedup;
+    /// The same with every worker slowed to the machine's measured ceiling efficiency at P (at
+    /// P > nproc the ceiling cannot be measured here and the value at nproc is used, an upper bound).
+    std::vector<double> model_speedup;
 };
 
 /// Seconds of each 8x8 block of the frame (row-major, ceil(W/8) per row), single-threaded on the
@@ -188,6 +227,14 @@ int run_scaling(cli::Args& args) {
     const Dims dims = volume.dims();
     std::cerr << "scaling: " << name << " " << dims.x << "x" << dims.y << "x" << dims.z << ", iso " << iso << "\n";
 
+    // The machine's ceiling on 1..max_threads threads (compute-bound, so the renderer cannot beat it).
+    std::vector<double> ceiling_speedup;   // index P-1
+    {
+        const int ceiling_repeats = quick ? 1 : 3;
+        const double one = compute_bound_seconds(1, ceiling_repeats);
+        for (int p = 1; p <= max_threads; ++p)
+            ceiling_speedup.push_back(p == 1 ? 1.0 : double(p) * one / compute_bound_seconds(p, ceiling_repeats));
+    }
     std::vector<Measured> measured;
     std::vector<Simulated> simulated;
     const std::vector<int> sim_workers = {1, 2, 4, 8, 16, 32, 64};
@@ -220,6 +267,11 @@ int run_scaling(cli::Args& args) {
                     r.cpu_seconds.push_back(process_cpu_seconds() - c0);
                 }
             for (auto& r : rows) measured.push_back(r);
+            // Serial per-frame time: the whole render() call minus its tile loop (one thread).
+            std::vector<double> serial;
+            for (size_t k = 0; k < rows.front().seconds.size(); ++k)
+                serial.push_back(std::max(0.0, rows.front().call_seconds[k] - rows.front().seconds[k]));
+            const double serial_seconds = Measured::median_of(serial);
 
             const std::vector<double> blocks = block_costs(tree, volume.placement(), camera, iso, quick ? 1 : 3);
             for (int ts : {16, 8}) {   // 16: the renderer's tiles; 8: what finer tiles would give
@@ -229,10 +281,16 @@ int run_scaling(cli::Args& args) {
                 const std::vector<double> cost = tile_costs(blocks, w, w, ts);
                 s.tiles = cost.size();
                 for (double c : cost) s.sum_seconds += c, s.max_tile_seconds = std::max(s.max_tile_seconds, c);
+                s.serial_seconds = serial_seconds;
                 for (int p : sim_workers) {
                     s.workers.push_back(p);
-                    s.dynamic_speedup.push_back(s.sum_seconds / list_schedule_makespan(cost, p));
+                    const double makespan = list_schedule_makespan(cost, p);
+                    s.dynamic_speedup.push_back(s.sum_seconds / makespan);
                     s.static_speedup.push_back(s.sum_seconds / static_makespan(cost, p));
+                    s.serial_speedup.push_back((serial_seconds + s.sum_seconds) / (serial_seconds + makespan));
+                    const int q = std::min(p, int(ceiling_speedup.size()));
+                    const double ceiling_eff = ceiling_speedup[size_t(q - 1)] / q;
+                    s.model_speedup.push_back((serial_seconds + s.sum_seconds) / (serial_seconds + makespan / ceiling_eff));
                 }
                 simulated.push_back(s);
             }
@@ -264,14 +322,26 @@ int run_scaling(cli::Args& args) {
     mt.print(std::cout);
     std::cout << "\n";
     mt.print_markdown(std::cout);
-    Table st({"image", "tile", "tiles", "max tile / mean", "P", "dynamic speedup", "dynamic eff.", "static speedup", "static eff."});
+    Table ct({"threads", "compute-bound speedup (measured ceiling)", "ceiling eff."});
+    for (size_t i = 0; i < ceiling_speedup.size(); ++i)
+        ct.add({std::to_string(i + 1), fmt(ceiling_speedup[i], 3), fmt(100.0 * ceiling_speedup[i] / double(i + 1), 1) + " %"});
+    std::cout << "\nmachine ceiling (measured): a compute-bound loop of fixed length per thread\n";
+    ct.print(std::cout);
+    std::cout << "\n";
+    ct.print_markdown(std::cout);
+    Table st({"image", "tile", "tiles", "max tile / mean", "P", "simulated dynamic eff.", "simulated static eff.",
+              "serial s/frame (measured)", "simulated eff. + serial", "simulated eff. + serial + ceiling"});
     for (const auto& s : simulated)
         for (size_t i = 0; i < s.workers.size(); ++i)
             st.add({std::to_string(s.width) + "^2", std::to_string(s.tile), std::to_string(s.tiles),
                     fmt(s.max_tile_seconds / (s.sum_seconds / double(s.tiles)), 2), std::to_string(s.workers[i]),
-                    fmt(s.dynamic_speedup[i], 2), fmt(100.0 * s.dynamic_speedup[i] / s.workers[i], 1) + " %",
-                    fmt(s.static_speedup[i], 2), fmt(100.0 * s.static_speedup[i] / s.workers[i], 1) + " %"});
-    std::cout << "\nsimulated schedule of measured tile costs (load-balance bound, no scheduling overhead)\n";
+                    fmt(100.0 * s.dynamic_speedup[i] / s.workers[i], 1) + " %", fmt(100.0 * s.static_speedup[i] / s.workers[i], 1) + " %",
+                    fmt(s.serial_seconds, 4), fmt(100.0 * s.serial_speedup[i] / s.workers[i], 1) + " %",
+                    fmt(100.0 * s.model_speedup[i] / s.workers[i], 1) + " %"});
+    std::cout << "\nSIMULATED schedule of measured tile costs (no scheduling overhead; the last two columns add the "
+                 "measured serial per-frame time and the measured machine ceiling, which beyond "
+              << ceiling_speedup.size() << " threads is assumed to stay at its " << ceiling_speedup.size()
+              << "-thread value)\n";
     st.print(std::cout);
     std::cout << "\n";
     st.print_markdown(std::cout);
@@ -281,6 +351,7 @@ int run_scaling(cli::Args& args) {
         j.field("machine", machine_description()).field("dataset", name).field("source", volume.source());
         j.key("dims").array(std::vector<uint32_t>{dims.x, dims.y, dims.z});
         j.field("iso", iso).field("repeats", repeats).field("loadavg", load);
+        j.key("ceiling_speedup").array(ceiling_speedup);   // measured, index = threads - 1
         j.key("measured").begin_array();
         for (const auto& m : measured) {
             j.begin_object();
@@ -299,6 +370,9 @@ int run_scaling(cli::Args& args) {
             j.key("workers").array(s.workers);
             j.key("dynamic_speedup").array(s.dynamic_speedup);
             j.key("static_speedup").array(s.static_speedup);
+            j.field("serial_seconds", s.serial_seconds);
+            j.key("serial_speedup").array(s.serial_speedup);
+            j.key("model_speedup").array(s.model_speedup);
             j.end_object();
         }
         j.end_array();
