@@ -1,5 +1,5 @@
 // What every octiso-bench subcommand shares: self-registration (one .cpp per question adds
-// itself), a printed table, the JSON result file in bench/results/, a PNG plot through Debian's
+// itself), a printed table, the JSON result file (--results DIR; bench/results/ holds the committed ones), a PNG plot through Debian's
 // /usr/bin/python3 + matplotlib, timers and peak RSS. Numbers are compared within one run, as
 // ratios, because the machines are shared and noisy.
 #pragma once
@@ -36,7 +36,8 @@ private:
 
 std::string fmt(double v, int precision = 3);   ///< fixed for moderate values, scientific otherwise
 
-/// bench/results/ of the source tree, or --results DIR (created if missing).
+/// --results DIR (created if missing), else $TMPDIR/octiso-bench-results: benchmarks write into the
+/// source tree only when asked (`--results bench/results`).
 std::string results_dir(cli::Args& args);
 /// Writes DIR/NAME.json through `fill` (which writes one object) and returns the path.
 std::string write_json(const std::string& dir, const std::string& name, const std::function<void(cli::JsonWriter&)>& fill);

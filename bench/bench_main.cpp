@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -76,9 +77,13 @@ std::string fmt(double v, int precision) {
 }
 
 std::string results_dir(cli::Args& args) {
+    // Never into the source tree unless asked (`--results bench/results`): by default a folder
+    // under the system temp dir, named in the "results:" line each subcommand prints.
     const auto dir = args.value("--results");
-    const std::string d = dir ? *dir : std::string(OCTISO_SOURCE_DIR) + "/bench/results";
-    ::mkdir(d.c_str(), 0755);
+    const std::string d = dir ? *dir : (std::filesystem::temp_directory_path() / "octiso-bench-results").string();
+    std::error_code ec;
+    std::filesystem::create_directories(d, ec);
+    if (ec) throw Error(d, "cannot create the results folder: " + ec.message(), ErrorKind::Other);
     return d;
 }
 
@@ -149,7 +154,7 @@ int main(int argc, char** argv) {
         auto& reg = bench::registry();
         if (argv.empty() || argv[0] == "--help" || argv[0] == "-h" || !reg.count(argv[0])) {
             std::ostream& out = argv.empty() || argv[0].rfind("-", 0) == 0 ? std::cout : std::cerr;
-            out << "usage: octiso-bench SUBCOMMAND [flags]   (--results DIR to write elsewhere than bench/results)\n";
+            out << "usage: octiso-bench SUBCOMMAND [flags]   (--results DIR: where JSON and plots go; default $TMPDIR/octiso-bench-results, never the source tree)\n";
             for (const auto& [name, e] : reg) out << "  " << name << std::string(name.size() < 14 ? 14 - name.size() : 1, ' ') << e.summary << "\n";
             if (!argv.empty() && argv[0].rfind("-", 0) != 0) throw Error(argv[0], "unknown subcommand");
             return 0;

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -32,10 +33,12 @@ namespace {
 
 const char* kUsage =
     "usage: octiso-bench peers [--dataset NAME[,NAME...]] [--size N] [--image WxH] [--iso V] [--repeats N]\n"
-    "                          [--threads N] [--mri FILE] [--bvh-quality both|medium|high]\n"
+    "                          [--threads N] [--mri FILE] [--bvh all|robust|fast] [--results DIR]\n"
     "                          [--mesh-normals geometric|vertex] [--quick] [--markdown] [--no-plot]\n"
     "  NAME: plume, mixing (synthetic, N^3, default 256) or mri (default /usr/share/mricron/templates/ch2.nii.gz)\n"
     "  --image: the frame, default 512x512; --quick: 128^3 synthetic, 256x256 frame, 1 repeat\n"
+    "  --bvh: the mesh's Embree builds: robust MEDIUM and HIGH, and non-robust HIGH (all, the default),\n"
+    "  robust only, or fast (non-robust HIGH) only; each is traced with rtcIntersect8 packets and rtcIntersect1\n"
     "  --mesh-normals: the mesh shades with the triangle's geometric normal (default: cheaper, and closer to the\n"
     "  exact normal on these data) or with flying edges' interpolated vertex normals";
 
@@ -46,13 +49,13 @@ struct OctisoResult {
     uint64_t file_bytes = 0;
     double load_seconds = 0;           ///< OctFile::open + step validation (page cache warm)
     double first_render_seconds = 0;   ///< wall time of a whole render() call
-    double render_seconds = 0;         ///< median tile-loop time
     Frame frame;
+    std::function<double()> render;    ///< one more frame; returns its tile-loop seconds
 };
 
 template <typename T>
-OctisoResult run_octiso(const LoadedVolume& volume, double iso, double warm_iso, const Camera& camera, int repeats,
-                        int threads, const std::string& oct_path) {
+OctisoResult run_octiso(const LoadedVolume& volume, double iso, double warm_iso, const Camera& camera, int threads,
+                        const std::string& oct_path) {
     OctisoResult r;
     {
         BuildOptions options;
@@ -72,10 +75,15 @@ OctisoResult run_octiso(const LoadedVolume& volume, double iso, double warm_iso,
     }
     r.file_bytes = std::filesystem::file_size(oct_path);
 
+    struct State {
+        OctFile file;
+        Octree<T> tree;
+    };
     auto t0 = std::chrono::steady_clock::now();
-    const OctFile file = OctFile::open(oct_path);   // Verify::Full: every checksum and index
+    OctFile file = OctFile::open(oct_path);   // Verify::Full: every checksum and index
     const Octree<T> tree = file.step<T>(0);
     r.load_seconds = seconds_since(t0);
+    auto state = std::make_shared<State>(State{std::move(file), tree});
 
     RenderOptions options;
     options.isovalues = {iso};
@@ -86,14 +94,11 @@ OctisoResult run_octiso(const LoadedVolume& volume, double iso, double warm_iso,
     // "After an isovalue change": one frame at another isovalue first, as in a running viewer.
     RenderOptions warm = options;
     warm.isovalues = {warm_iso};
-    (void)render(tree, file.info().placement, camera, warm);
+    (void)render(state->tree, state->file.info().placement, camera, warm);
     t0 = std::chrono::steady_clock::now();
-    r.frame = render(tree, file.info().placement, camera, options);
+    r.frame = render(state->tree, state->file.info().placement, camera, options);
     r.first_render_seconds = seconds_since(t0);
-    std::vector<double> seconds;
-    for (int k = 0; k < std::max(repeats, 1); ++k) seconds.push_back(render(tree, file.info().placement, camera, options).stats.seconds);
-    std::sort(seconds.begin(), seconds.end());
-    r.render_seconds = seconds[seconds.size() / 2];
+    r.render = [state, camera, options] { return render(state->tree, state->file.info().placement, camera, options).stats.seconds; };
     return r;
 }
 
@@ -157,8 +162,15 @@ LoadedVolume open_dataset(const std::string& name, uint32_t n, const std::string
     throw Error("--dataset", "expected plume, mixing or mri, found '" + name + "'");
 }
 
+/// One mesh configuration the benchmark builds.
+struct MeshConfig {
+    BvhQuality quality;
+    bool robust;
+    std::string name() const { return bvh_quality_name(quality) + (robust ? ", robust" : ", not robust"); }
+};
+
 DatasetResult run_dataset(const std::string& name, const LoadedVolume& volume, double iso, const Camera& camera, int repeats,
-                          int threads, const std::vector<BvhQuality>& qualities, bool vertex_normals) {
+                          int threads, const std::vector<MeshConfig>& configs, bool vertex_normals) {
     DatasetResult d;
     d.name = name;
     d.source = volume.source();
@@ -185,6 +197,8 @@ DatasetResult run_dataset(const std::string& name, const LoadedVolume& volume, d
     const double warm_iso = warm_up_iso(volume, iso);
     d.notes.push_back("first image = the first frame after a warm-up frame (and for the mesh and OpenVDB the whole "
                       "preprocessing) at isovalue " + fmt(warm_iso, 3));
+    d.notes.push_back("render s = median of " + std::to_string(repeats) + " frames per method, interleaved: each round renders "
+                      "every method once, the order rotating by one method per round");
 
     // (c) octiso.
     const std::string oct_path = (std::filesystem::temp_directory_path() /
@@ -192,66 +206,106 @@ DatasetResult run_dataset(const std::string& name, const LoadedVolume& volume, d
     OctisoResult oct;
     try {
         oct = dispatch_scalar_type(volume.type(), [&](auto tag) {
-            return run_octiso<decltype(tag)>(volume, iso, warm_iso, camera, repeats, threads, oct_path);
+            return run_octiso<decltype(tag)>(volume, iso, warm_iso, camera, threads, oct_path);
         });
     } catch (...) {
         std::filesystem::remove(oct_path);
         throw;
     }
-    std::filesystem::remove(oct_path);
-    std::cerr << "  octiso: render " << fmt(oct.render_seconds) << " s\n";
+    std::filesystem::remove(oct_path);   // the mapping stays valid after the unlink
+
+    // (a) flying edges -> Embree. One untimed pass at the warm-up isovalue first, so that no build
+    // pays the process's first Embree device and first large allocations.
+    {
+        MeshPeerOptions warm;
+        warm.quality = configs.front().quality;
+        warm.robust = configs.front().robust;
+        warm.threads = threads;
+        (void)run_mesh_peer(volume, warm_iso, camera, warm);
+    }
+    std::vector<MeshPeerResult> meshes;
+    for (const MeshConfig& c : configs) {
+        MeshPeerOptions options;
+        options.quality = c.quality;
+        options.robust = c.robust;
+        options.vertex_normals = vertex_normals;
+        options.threads = threads;
+        meshes.push_back(run_mesh_peer(volume, iso, camera, options));
+        std::cerr << "  mesh (" << c.name() << "): " << meshes.back().triangles << " triangles, extract "
+                  << fmt(meshes.back().extract_seconds) << " s, BVH " << fmt(meshes.back().bvh_seconds) << " s\n";
+    }
+
+    // (b) OpenVDB.
+    (void)run_vdb_peer(volume, warm_iso, camera);   // warm-up, as above
+    VdbPeerResult vdb = run_vdb_peer(volume, iso, camera);
+
+    // The timed repeats, interleaved: every round renders each method once, so a burst of load from
+    // another process on this shared machine lands on all methods alike, not on one.
+    std::vector<std::pair<std::string, std::function<double()>>> methods;
+    methods.emplace_back("octiso", oct.render);
+    for (size_t m = 0; m < meshes.size(); ++m)
+        for (MeshRays rays : {MeshRays::packet8, MeshRays::single})
+            methods.emplace_back("mesh " + std::to_string(m) + " " + mesh_rays_name(rays),
+                                 [&meshes, m, rays] { return meshes[m].render(rays, nullptr); });
+    if (vdb.ran) methods.emplace_back("openvdb", [&vdb] { return vdb.render(nullptr); });
+    std::vector<std::vector<double>> seconds(methods.size());
+    for (int k = 0; k < std::max(repeats, 1); ++k)
+        for (size_t i = 0; i < methods.size(); ++i) {
+            const size_t j = (i + size_t(k)) % methods.size();
+            seconds[j].push_back(methods[j].second());
+        }
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        return v[v.size() / 2];
+    };
+    size_t next = 0;
+    const double oct_render = median(seconds[next++]);
+    std::cerr << "  octiso: render " << fmt(oct_render) << " s\n";
     {
         Row row;
         row.method = "octiso (lossless .oct)";
         row.prep_seconds = oct.load_seconds;
-        row.render_seconds = oct.render_seconds;
+        row.render_seconds = oct_render;
         row.ttfi_seconds = oct.first_render_seconds;
         row.bytes = oct.file_bytes;
         row.error = compare_frames(oct.frame, reference, voxel);
-        row.note = "prep = load + validate; octree build (once per volume) " + fmt(oct.build_seconds) + " s";
+        row.note = "prep = load + validate; octree build (once per volume) " + fmt(oct.build_seconds) + " s; render() with "
+                   "its Embree user geometry, 8-ray packets along tile rows";
         d.rows.push_back(row);
     }
-
-    // (a) flying edges -> Embree. One untimed pass at the warm-up isovalue first, so that neither
-    // build quality pays the process's first Embree device and first large allocations.
-    std::vector<MeshPeerResult> meshes;
-    {
-        MeshPeerOptions warm;
-        warm.quality = qualities.front();
-        warm.repeats = 1;
-        warm.threads = threads;
-        (void)run_mesh_peer(volume, warm_iso, camera, warm);
+    double best_mesh_render = INFINITY, best_mesh_ttfi = INFINITY;
+    uint64_t least_mesh_bytes = UINT64_MAX;
+    std::string best_mesh_name;
+    for (size_t m = 0; m < meshes.size(); ++m) {
+        const MeshPeerResult& mr = meshes[m];
+        const ImageError error = compare_frames(mr.frame, reference, voxel);
+        const ImageError geometric = compare_frames(mr.frame_geometric, reference, voxel);
+        for (MeshRays rays : {MeshRays::packet8, MeshRays::single}) {
+            const double render_s = median(seconds[next++]);
+            Row row;
+            row.method = "FE + Embree (" + configs[m].name() + ", " + mesh_rays_name(rays) + ")";
+            row.prep_seconds = mr.extract_seconds;
+            row.bvh_seconds = mr.bvh_seconds;
+            row.render_seconds = render_s;
+            // The first frame is always traced with packets, so both rows share it.
+            row.ttfi_seconds = mr.time_to_first_image();
+            row.bytes = mr.mesh_bytes + mr.bvh_bytes;
+            row.error = error;
+            row.note = std::to_string(mr.triangles) + " triangles, mesh " + mb(mr.mesh_bytes) + " MB + BVH " + mb(mr.bvh_bytes) +
+                       " MB; " + (vertex_normals ? "interpolated vertex normals (geometric normal error: " + normal_cell(geometric) + " deg)"
+                                                 : std::string("geometric normals"));
+            d.rows.push_back(row);
+            if (render_s < best_mesh_render) best_mesh_render = render_s, best_mesh_name = row.method;
+        }
+        best_mesh_ttfi = std::min(best_mesh_ttfi, mr.time_to_first_image());
+        least_mesh_bytes = std::min(least_mesh_bytes, mr.mesh_bytes + mr.bvh_bytes);
+        std::cerr << "  mesh (" << configs[m].name() << "): render " << fmt(d.rows[d.rows.size() - 2].render_seconds) << " s (8), "
+                  << fmt(d.rows.back().render_seconds) << " s (1)\n";
     }
-    for (BvhQuality q : qualities) {
-        MeshPeerOptions options;
-        options.quality = q;
-        options.vertex_normals = vertex_normals;
-        options.repeats = repeats;
-        options.threads = threads;
-        MeshPeerResult m = run_mesh_peer(volume, iso, camera, options);
-        std::cerr << "  mesh (" << bvh_quality_name(q) << "): " << m.triangles << " triangles, extract " << fmt(m.extract_seconds)
-                  << " s, BVH " << fmt(m.bvh_seconds) << " s, render " << fmt(m.render_seconds) << " s\n";
-        Row row;
-        row.method = "FE + Embree (" + bvh_quality_name(q) + ")";
-        row.prep_seconds = m.extract_seconds;
-        row.bvh_seconds = m.bvh_seconds;
-        row.render_seconds = m.render_seconds;
-        row.ttfi_seconds = m.time_to_first_image();
-        row.bytes = m.mesh_bytes + m.bvh_bytes;
-        row.error = compare_frames(m.frame, reference, voxel);
-        const ImageError geometric = compare_frames(m.frame_geometric, reference, voxel);
-        row.note = std::to_string(m.triangles) + " triangles, mesh " + mb(m.mesh_bytes) + " MB + BVH " + mb(m.bvh_bytes) +
-                   " MB; " + (vertex_normals ? "interpolated vertex normals (geometric normal error: " + normal_cell(geometric) + " deg)"
-                                             : std::string("geometric normals"));
-        d.rows.push_back(row);
-        meshes.push_back(std::move(m));
-    }
-
-    // (b) OpenVDB.
-    (void)run_vdb_peer(volume, warm_iso, camera, 1);   // warm-up, as above
-    VdbPeerResult vdb = run_vdb_peer(volume, iso, camera, repeats);
+    double vdb_render = NAN;
     if (vdb.ran) {
-        std::cerr << "  openvdb: level set " << fmt(vdb.levelset_seconds) << " s, render " << fmt(vdb.render_seconds) << " s\n";
+        vdb_render = median(seconds[next++]);
+        std::cerr << "  openvdb: level set " << fmt(vdb.levelset_seconds) << " s, render " << fmt(vdb_render) << " s\n";
         Row dense;
         dense.method = "OpenVDB float grid (bytes only)";
         dense.prep_seconds = vdb.dense_seconds;
@@ -262,7 +316,7 @@ DatasetResult run_dataset(const std::string& name, const LoadedVolume& volume, d
         Row ls;
         ls.method = "OpenVDB level set";
         ls.prep_seconds = vdb.to_float_seconds + vdb.levelset_seconds;
-        ls.render_seconds = vdb.render_seconds;
+        ls.render_seconds = vdb_render;
         ls.ttfi_seconds = vdb.time_to_first_image();
         ls.bytes = vdb.levelset_bytes;
         ls.error = compare_frames(vdb.frame, reference, voxel);
@@ -279,24 +333,17 @@ DatasetResult run_dataset(const std::string& name, const LoadedVolume& volume, d
         d.rows.push_back(raw);
     }
 
-    // The targets, each as a ratio where higher is better.
+    // The targets, each as a ratio where higher is better, against the peer's best row.
     if (!meshes.empty()) {
-        double best_render = INFINITY, best_ttfi = INFINITY;
-        uint64_t least_bytes = UINT64_MAX;
-        for (const auto& m : meshes) {
-            best_render = std::min(best_render, m.render_seconds);
-            best_ttfi = std::min(best_ttfi, m.time_to_first_image());
-            least_bytes = std::min(least_bytes, m.mesh_bytes + m.bvh_bytes);
-        }
-        d.targets.push_back({"octree render speed / Embree mesh render speed", best_render / oct.render_seconds, 0.5,
-                             "fastest Embree render / octiso render"});
-        d.targets.push_back({"time to first image after an isovalue change, mesh / octree", best_ttfi / oct.first_render_seconds,
-                             10.0, "(extract + BVH + first render, best quality) / octiso's first render"});
-        d.targets.push_back({"(mesh + BVH bytes) / octree bytes", double(least_bytes) / double(oct.file_bytes), 3.0,
+        d.targets.push_back({"octree render speed / Embree mesh render speed", best_mesh_render / oct_render, 0.5,
+                             "fastest Embree row (" + best_mesh_name + ") / octiso render"});
+        d.targets.push_back({"time to first image after an isovalue change, mesh / octree", best_mesh_ttfi / oct.first_render_seconds,
+                             10.0, "(extract + BVH + first render, fastest configuration) / octiso's first render"});
+        d.targets.push_back({"(mesh + BVH bytes) / octree bytes", double(least_mesh_bytes) / double(oct.file_bytes), 3.0,
                              "smallest mesh + BVH / .oct file bytes"});
     }
     if (vdb.ran)
-        d.targets.push_back({"OpenVDB level-set render time / octree render time", vdb.render_seconds / oct.render_seconds, 3.0,
+        d.targets.push_back({"OpenVDB level-set render time / octree render time", vdb_render / oct_render, 3.0,
                              "LevelSetRayIntersector render / octiso render"});
     return d;
 }
@@ -348,16 +395,16 @@ int run_peers(cli::Args& args) {
     const int repeats = int(cli::parse_int(args.value("--repeats").value_or(quick ? "1" : "3"), "--repeats", 1, 1000));
     const int threads = int(cli::parse_int(args.value("--threads").value_or("0"), "--threads", 0, 4096));
     const std::string mri = args.value("--mri").value_or("/usr/share/mricron/templates/ch2.nii.gz");
-    const std::string quality = args.value("--bvh-quality").value_or("both");
+    const std::string bvh = args.value("--bvh").value_or("all");
     const std::string normals = args.value("--mesh-normals").value_or("geometric");
     const bool markdown = args.flag("--markdown"), no_plot = args.flag("--no-plot");
     const std::string dir = results_dir(args);
     args.finish();
 
-    std::vector<BvhQuality> qualities;
-    if (quality == "both" || quality == "medium") qualities.push_back(BvhQuality::medium);
-    if (quality == "both" || quality == "high") qualities.push_back(BvhQuality::high);
-    if (qualities.empty()) throw Error("--bvh-quality", "expected both, medium or high, found '" + quality + "'");
+    std::vector<MeshConfig> configs;
+    if (bvh == "all" || bvh == "robust") configs.push_back({BvhQuality::medium, true}), configs.push_back({BvhQuality::high, true});
+    if (bvh == "all" || bvh == "fast") configs.push_back({BvhQuality::high, false});
+    if (configs.empty()) throw Error("--bvh", "expected all, robust or fast, found '" + bvh + "'");
     if (normals != "vertex" && normals != "geometric")
         throw Error("--mesh-normals", "expected vertex or geometric, found '" + normals + "'");
     std::vector<std::string> names;
@@ -375,7 +422,7 @@ int run_peers(cli::Args& args) {
         LoadedVolume volume = open_dataset(name, n, mri);
         const double iso = iso_text ? cli::parse_double(*iso_text, "--iso") : default_isovalue(name);
         const Camera camera = frame_data_box(volume.dims(), volume.placement(), image[0], image[1]);
-        results.push_back(run_dataset(name, volume, iso, camera, repeats, threads, qualities, normals == "vertex"));
+        results.push_back(run_dataset(name, volume, iso, camera, repeats, threads, configs, normals == "vertex"));
         print_dataset(results.back(), markdown);
     }
 

@@ -1,11 +1,11 @@
 // The extract-then-trace peer: vtkFlyingEdges3D (VTK's fastest extractor, TBB backend) -> Embree 3
-// triangle BVH (RTC_SCENE_FLAG_ROBUST, medium or high build quality) -> rtcIntersect1 over the
-// same 16x16 TBB tiles and the same PinholeCamera rays as octiso. Embree's own bytes are counted
-// through its device memory monitor; the mesh buffers are ours and counted exactly.
+// triangle BVH (robust or not, medium or high build quality) -> rtcIntersect8 packets along tile
+// rows (coherent context) or rtcIntersect1, over the same TBB tiles (tile_size_for, as render())
+// and the same PinholeCamera rays as octiso. Embree's own bytes are counted through its device
+// memory monitor; the mesh buffers are ours and counted exactly.
 #include "bench/peers_mesh.h"
 
 #include <embree3/rtcore.h>
-#include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 #include <vtkAOSDataArrayTemplate.h>
 #include <vtkCellArray.h>
@@ -23,15 +23,18 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "bench/bench.h"
 #include "octiso/error.h"
 #include "render/pinhole_camera.h"
+#include "render/tile_loop.h"
 
 namespace octiso::bench {
 
 std::string bvh_quality_name(BvhQuality q) { return q == BvhQuality::high ? "high" : "medium"; }
+std::string mesh_rays_name(MeshRays r) { return r == MeshRays::packet8 ? "rtcIntersect8" : "rtcIntersect1"; }
 
 namespace {
 
@@ -130,6 +133,130 @@ void throw_on_embree_error(RTCDevice device, const char* what) {
     if (e != RTC_ERROR_NONE) throw Error("embree", std::string(what) + " failed (error " + std::to_string(int(e)) + ")", ErrorKind::Other);
 }
 
+/// What stays alive between the frames of one mesh configuration: Embree's device and scene and
+/// the buffers they share.
+struct MeshScene {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    Mesh mesh;
+    MeshScene() = default;
+    MeshScene(const MeshScene&) = delete;
+    MeshScene& operator=(const MeshScene&) = delete;
+    ~MeshScene() {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+/// One frame of `camera` through `ms` with `rays`; tile-loop seconds in frame.stats.seconds.
+void render_mesh_frame(const MeshScene& ms, const Camera& camera, bool vertex_normals, MeshRays rays, Frame& frame,
+                       Frame* geometric) {
+    const PinholeCamera pinhole(camera);
+    const int W = camera.width, H = camera.height;
+    frame.width = W, frame.height = H;
+    frame.depth.assign(size_t(W) * H, 0.0f);
+    frame.normal.assign(size_t(W) * H * 3, 0.0f);
+    if (geometric) {
+        geometric->width = W, geometric->height = H;
+        geometric->normal.assign(size_t(W) * H * 3, 0.0f);
+    }
+    const Mesh& mesh = ms.mesh;
+    std::atomic<uint64_t> hits{0};
+    // Unit length and facing the ray, as CONVENTIONS 2 asks of every normal AOV.
+    auto store = [](const float* v, const Ray& ray, size_t i, std::vector<float>& out) {
+        const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (!(len > 0)) {
+            for (int a = 0; a < 3; ++a) out[3 * i + a] = -float(ray.dir[a]);
+            return;
+        }
+        const float facing = v[0] * float(ray.dir[0]) + v[1] * float(ray.dir[1]) + v[2] * float(ray.dir[2]) > 0 ? -1.0f : 1.0f;
+        for (int a = 0; a < 3; ++a) out[3 * i + a] = facing * v[a] / len;
+    };
+    // One hit (or miss) of pixel i: depth, and the chosen and geometric normals.
+    auto shade = [&](const Ray& ray, size_t i, bool hit, float tfar, unsigned prim, float u, float v, const float ng[3]) {
+        if (!hit) {
+            frame.depth[i] = std::numeric_limits<float>::infinity();
+            return false;
+        }
+        frame.depth[i] = tfar;
+        float n[3] = {ng[0], ng[1], ng[2]};
+        if (vertex_normals) {
+            const uint32_t* tri = &mesh.indices[3 * size_t(prim)];
+            const float w0 = 1.0f - u - v;
+            for (int a = 0; a < 3; ++a)
+                n[a] = w0 * mesh.normals[3 * tri[0] + a] + u * mesh.normals[3 * tri[1] + a] + v * mesh.normals[3 * tri[2] + a];
+        }
+        store(n, ray, i, frame.normal);
+        if (geometric) store(ng, ray, i, geometric->normal);
+        return true;
+    };
+    const int ts = tile_size_for(W, H, 0);   // the tile side render() uses for this frame
+    const auto t0 = std::chrono::steady_clock::now();
+    for_each_tile(  // render()'s tile loop over render()'s tiles
+        TileGrid{W, H, ts}, {}, true,
+        [&](const PixelRect& tile, TileCounters&) {
+            uint64_t tile_hits = 0;
+            RTCIntersectContext context;
+            rtcInitIntersectContext(&context);
+            if (rays == MeshRays::packet8) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+            for (int py = tile.y0; py < tile.y1; ++py) {
+                if (rays == MeshRays::packet8) {
+                    // Runs of up to 8 pixels of this tile row, one rtcIntersect8 each (as render()).
+                    for (int x0 = tile.x0; x0 < tile.x1; x0 += 8) {
+                        const int count = std::min(8, tile.x1 - x0);
+                        Ray ray[8];
+                        alignas(32) RTCRayHit8 rh{};
+                        alignas(32) int valid[8];
+                        for (int k = 0; k < 8; ++k) {
+                            valid[k] = k < count ? -1 : 0;
+                            ray[k] = pinhole.ray(x0 + (k < count ? k : 0), py);
+                            rh.ray.org_x[k] = float(ray[k].origin[0]), rh.ray.org_y[k] = float(ray[k].origin[1]);
+                            rh.ray.org_z[k] = float(ray[k].origin[2]);
+                            rh.ray.dir_x[k] = float(ray[k].dir[0]), rh.ray.dir_y[k] = float(ray[k].dir[1]);
+                            rh.ray.dir_z[k] = float(ray[k].dir[2]);
+                            rh.ray.tnear[k] = 0.0f;
+                            rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
+                            rh.ray.mask[k] = ~0u;   // Debian's Embree is built with ray masks: 0 would hit nothing
+                            rh.ray.flags[k] = 0;
+                            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+                        }
+                        rtcIntersect8(valid, ms.scene, &context, &rh);
+                        for (int k = 0; k < count; ++k) {
+                            const float ng[3] = {rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]};
+                            tile_hits += shade(ray[k], size_t(py) * W + size_t(x0 + k), rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID,
+                                               rh.ray.tfar[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k], ng);
+                        }
+                    }
+                    continue;
+                }
+                for (int px = tile.x0; px < tile.x1; ++px) {
+                    const Ray ray = pinhole.ray(px, py);
+                    RTCRayHit rh;
+                    rh.ray.org_x = float(ray.origin[0]), rh.ray.org_y = float(ray.origin[1]), rh.ray.org_z = float(ray.origin[2]);
+                    rh.ray.dir_x = float(ray.dir[0]), rh.ray.dir_y = float(ray.dir[1]), rh.ray.dir_z = float(ray.dir[2]);
+                    rh.ray.tnear = 0.0f;
+                    rh.ray.tfar = std::numeric_limits<float>::infinity();
+                    rh.ray.time = 0.0f;
+                    rh.ray.mask = ~0u;
+                    rh.ray.id = 0;
+                    rh.ray.flags = 0;
+                    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                    rtcIntersect1(ms.scene, &context, &rh);
+                    const float ng[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+                    tile_hits += shade(ray, size_t(py) * W + px, rh.hit.geomID != RTC_INVALID_GEOMETRY_ID, rh.ray.tfar,
+                                       rh.hit.primID, rh.hit.u, rh.hit.v, ng);
+                }
+            }
+            hits += tile_hits;
+        });
+    frame.stats.seconds = seconds_since(t0);
+    frame.stats.rays = uint64_t(W) * H;
+    frame.stats.hits = hits;
+    if (geometric) geometric->depth = frame.depth;
+}
+
 }  // namespace
 
 MeshPeerResult run_mesh_peer(const LoadedVolume& volume, double iso, const Camera& camera, const MeshPeerOptions& options) {
@@ -139,7 +266,6 @@ MeshPeerResult run_mesh_peer(const LoadedVolume& volume, double iso, const Camer
 
     // 1. Extraction. The image wrapper is set up before the clock starts: it shares the voxels.
     vtkNew<vtkFlyingEdges3D> flying_edges;
-    Mesh mesh;
     {
         auto extract = [&](auto tag) {
             using T = decltype(tag);
@@ -159,135 +285,55 @@ MeshPeerResult run_mesh_peer(const LoadedVolume& volume, double iso, const Camer
     }
 
     // 2. Upload and BVH build.
+    auto ms = std::make_shared<MeshScene>();
     const std::string config = options.threads > 0 ? "threads=" + std::to_string(options.threads) : "";
-    RTCDevice device = rtcNewDevice(config.c_str());
-    if (!device) throw Error("embree", "rtcNewDevice failed", ErrorKind::Other);
+    ms->device = rtcNewDevice(config.c_str());
+    if (!ms->device) throw Error("embree", "rtcNewDevice failed", ErrorKind::Other);
     MemoryMonitor monitor;
-    rtcSetDeviceMemoryMonitorFunction(device, monitor_callback, &monitor);
-    RTCScene scene = nullptr;
-    try {
+    rtcSetDeviceMemoryMonitorFunction(ms->device, monitor_callback, &monitor);
+    {
         const auto t0 = std::chrono::steady_clock::now();
-        mesh = mesh_of(flying_edges->GetOutput(), options.vertex_normals);
+        ms->mesh = mesh_of(flying_edges->GetOutput(), options.vertex_normals);
         flying_edges->GetOutput()->Initialize();   // the renderer keeps only `mesh`
-        scene = rtcNewScene(device);
-        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
-        rtcSetSceneBuildQuality(scene, options.quality == BvhQuality::high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+        const Mesh& mesh = ms->mesh;
+        ms->scene = rtcNewScene(ms->device);
+        if (options.robust) rtcSetSceneFlags(ms->scene, RTC_SCENE_FLAG_ROBUST);
+        const RTCBuildQuality quality = options.quality == BvhQuality::high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
+        rtcSetSceneBuildQuality(ms->scene, quality);
         if (mesh.triangles > 0) {
-            RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-            rtcSetGeometryBuildQuality(geometry, options.quality == BvhQuality::high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+            RTCGeometry geometry = rtcNewGeometry(ms->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+            rtcSetGeometryBuildQuality(geometry, quality);
             rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
                                        3 * sizeof(float), size_t(mesh.vertices));
             rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
                                        3 * sizeof(uint32_t), size_t(mesh.triangles));
             rtcCommitGeometry(geometry);
-            rtcAttachGeometry(scene, geometry);
+            rtcAttachGeometry(ms->scene, geometry);
             rtcReleaseGeometry(geometry);
         }
-        rtcCommitScene(scene);
+        rtcCommitScene(ms->scene);
         result.bvh_seconds = seconds_since(t0);
-        throw_on_embree_error(device, "building the triangle BVH");
-    } catch (...) {
-        if (scene) rtcReleaseScene(scene);
-        rtcReleaseDevice(device);
-        throw;
+        throw_on_embree_error(ms->device, "building the triangle BVH");
     }
+    // The monitor belongs to this frame: later frames allocate nothing, and it must not outlive us.
+    result.bvh_bytes = uint64_t(std::max(0LL, monitor.bytes.load()));
+    rtcSetDeviceMemoryMonitorFunction(ms->device, nullptr, nullptr);
+    const Mesh& mesh = ms->mesh;
     result.vertices = mesh.vertices;
     result.triangles = mesh.triangles;
     result.mesh_bytes = (mesh.positions.size() + mesh.normals.size()) * sizeof(float) + mesh.indices.size() * sizeof(uint32_t);
-    result.bvh_bytes = uint64_t(std::max(0LL, monitor.bytes.load()));
 
-    // 3. Rendering: the same rays, tiles and partitioner as octiso's render().
-    const PinholeCamera pinhole(camera);
-    const int W = camera.width, H = camera.height;
-    auto render_once = [&](Frame& frame, Frame* geometric) {
-        frame.width = W, frame.height = H;
-        frame.depth.assign(size_t(W) * H, 0.0f);
-        frame.normal.assign(size_t(W) * H * 3, 0.0f);
-        if (geometric) {
-            geometric->width = W, geometric->height = H;
-            geometric->normal.assign(size_t(W) * H * 3, 0.0f);
-        }
-        std::atomic<uint64_t> hits{0};
-        const auto t0 = std::chrono::steady_clock::now();
-        tbb::parallel_for(
-            tbb::blocked_range2d<int>(0, H, 16, 0, W, 16),
-            [&](const tbb::blocked_range2d<int>& tile) {
-                RTCIntersectContext context;
-                rtcInitIntersectContext(&context);
-                uint64_t tile_hits = 0;
-                for (int py = tile.rows().begin(); py < tile.rows().end(); ++py)
-                    for (int px = tile.cols().begin(); px < tile.cols().end(); ++px) {
-                        const Ray ray = pinhole.ray(px, py);
-                        RTCRayHit rh;
-                        rh.ray.org_x = float(ray.origin[0]), rh.ray.org_y = float(ray.origin[1]), rh.ray.org_z = float(ray.origin[2]);
-                        rh.ray.dir_x = float(ray.dir[0]), rh.ray.dir_y = float(ray.dir[1]), rh.ray.dir_z = float(ray.dir[2]);
-                        rh.ray.tnear = 0.0f;
-                        rh.ray.tfar = std::numeric_limits<float>::infinity();
-                        rh.ray.time = 0.0f;
-                        rh.ray.mask = ~0u;   // Debian's Embree is built with ray masks: 0 would hit nothing
-                        rh.ray.id = 0;
-                        rh.ray.flags = 0;
-                        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-                        rtcIntersect1(scene, &context, &rh);
-                        const size_t i = size_t(py) * W + px;
-                        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-                            frame.depth[i] = std::numeric_limits<float>::infinity();
-                            continue;
-                        }
-                        ++tile_hits;
-                        frame.depth[i] = rh.ray.tfar;
-                        float ng[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
-                        float n[3] = {ng[0], ng[1], ng[2]};
-                        if (options.vertex_normals) {
-                            const uint32_t* tri = &mesh.indices[3 * size_t(rh.hit.primID)];
-                            const float w0 = 1.0f - rh.hit.u - rh.hit.v;
-                            for (int a = 0; a < 3; ++a)
-                                n[a] = w0 * mesh.normals[3 * tri[0] + a] + rh.hit.u * mesh.normals[3 * tri[1] + a] +
-                                       rh.hit.v * mesh.normals[3 * tri[2] + a];
-                        }
-                        // Unit length and facing the ray, as CONVENTIONS 2 asks of every normal AOV.
-                        auto store = [&](const float* v, std::vector<float>& out) {
-                            const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-                            if (!(len > 0)) {
-                                for (int a = 0; a < 3; ++a) out[3 * i + a] = -float(ray.dir[a]);
-                                return;
-                            }
-                            const float facing = v[0] * float(ray.dir[0]) + v[1] * float(ray.dir[1]) + v[2] * float(ray.dir[2]) > 0 ? -1.0f : 1.0f;
-                            for (int a = 0; a < 3; ++a) out[3 * i + a] = facing * v[a] / len;
-                        };
-                        store(n, frame.normal);
-                        if (geometric) store(ng, geometric->normal);
-                    }
-                hits += tile_hits;
-            },
-            tbb::simple_partitioner());
-        frame.stats.seconds = seconds_since(t0);
-        frame.stats.rays = uint64_t(W) * H;
-        frame.stats.hits = hits;
-        if (geometric) geometric->depth = frame.depth;
-    };
-
-    try {
-        const auto t0 = std::chrono::steady_clock::now();
-        render_once(result.frame, &result.frame_geometric);
-        result.first_render_seconds = seconds_since(t0);
-        std::vector<double> seconds;
+    // 3. The first frame (packets, as render() does); the caller times the repeats through `render`.
+    const auto t0 = std::chrono::steady_clock::now();
+    render_mesh_frame(*ms, camera, options.vertex_normals, MeshRays::packet8, result.frame, &result.frame_geometric);
+    result.first_render_seconds = seconds_since(t0);
+    const bool vertex_normals = options.vertex_normals;
+    result.render = [ms, camera, vertex_normals](MeshRays rays, Frame* out) {
         Frame scratch;
-        for (int r = 0; r < std::max(options.repeats, 1); ++r) {
-            render_once(scratch, nullptr);
-            seconds.push_back(scratch.stats.seconds);
-        }
-        std::sort(seconds.begin(), seconds.end());
-        result.render_seconds = seconds[seconds.size() / 2];
-        result.frame.stats.seconds = result.render_seconds;
-    } catch (...) {
-        rtcReleaseScene(scene);
-        rtcReleaseDevice(device);
-        throw;
-    }
-    rtcReleaseScene(scene);
-    rtcReleaseDevice(device);
+        Frame& f = out ? *out : scratch;
+        render_mesh_frame(*ms, camera, vertex_normals, rays, f, nullptr);
+        return f.stats.seconds;
+    };
     return result;
 }
 

@@ -9,7 +9,7 @@
 
 namespace octiso::bench {
 bool vdb_available() { return false; }
-VdbPeerResult run_vdb_peer(const LoadedVolume&, double, const Camera&, int) {
+VdbPeerResult run_vdb_peer(const LoadedVolume&, double, const Camera&) {
     VdbPeerResult r;
     r.skipped = "OpenVDB was not found when octiso-bench was configured";
     return r;
@@ -22,7 +22,6 @@ VdbPeerResult run_vdb_peer(const LoadedVolume&, double, const Camera&, int) {
 #include <openvdb/tools/Dense.h>
 #include <openvdb/tools/RayIntersector.h>
 #include <tbb/blocked_range.h>
-#include <tbb/blocked_range2d.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -32,10 +31,12 @@ VdbPeerResult run_vdb_peer(const LoadedVolume&, double, const Camera&, int) {
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "bench/bench.h"
 #include "render/pinhole_camera.h"
+#include "render/tile_loop.h"
 
 namespace octiso::bench {
 
@@ -92,7 +93,7 @@ openvdb::FloatGrid::Ptr grid_from_dense(std::vector<float>& values, Dims d, floa
 
 }  // namespace
 
-VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera& camera, int repeats) {
+VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera& camera) {
     using namespace openvdb;
     openvdb::initialize();
     VdbPeerResult r;
@@ -138,10 +139,17 @@ VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera&
     tbb::parallel_for(tbb::blocked_range<size_t>(0, values.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& b) {
         for (size_t i = b.begin(); i < b.end(); ++i) values[i] = s * (v - values[i]);
     });
-    FloatGrid::Ptr level_set = grid_from_dense(values, d, float(r.background), p, h);
+    // What stays alive between frames: the grid and the intersector that refers to it.
+    struct State {
+        FloatGrid::Ptr level_set;
+        std::unique_ptr<Intersector> master;
+    };
+    auto state = std::make_shared<State>();
+    state->level_set = grid_from_dense(values, d, float(r.background), p, h);
+    FloatGrid::Ptr level_set = state->level_set;
     level_set->setGridClass(GRID_LEVEL_SET);
     std::vector<float>().swap(values);
-    const Intersector master(*level_set, 0.0f);
+    state->master = std::make_unique<Intersector>(*level_set, 0.0f);
     r.levelset_seconds = seconds_since(t0);
     r.levelset_bytes = level_set->memUsage();
 
@@ -149,20 +157,21 @@ VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera&
     // (it caches a ValueAccessor and is not thread-safe).
     const PinholeCamera pinhole(camera);
     const int W = camera.width, H = camera.height;
-    auto render_once = [&](Frame& frame) {
+    auto render_once = [state, pinhole, W, H](Frame& frame) {
+        const Intersector& master = *state->master;
         frame.width = W, frame.height = H;
         frame.depth.assign(size_t(W) * H, 0.0f);
         frame.normal.assign(size_t(W) * H * 3, 0.0f);
         tbb::enumerable_thread_specific<Intersector> per_thread(master);
         std::atomic<uint64_t> hits{0};
         const auto start = std::chrono::steady_clock::now();
-        tbb::parallel_for(
-            tbb::blocked_range2d<int>(0, H, 16, 0, W, 16),
-            [&](const tbb::blocked_range2d<int>& tile) {
+        for_each_tile(  // render()'s tile loop over render()'s tiles
+            tile_grid_for(W, H, 0), {}, true,
+            [&](const PixelRect& tile, TileCounters&) {
                 Intersector& intersector = per_thread.local();
                 uint64_t tile_hits = 0;
-                for (int py = tile.rows().begin(); py < tile.rows().end(); ++py)
-                    for (int px = tile.cols().begin(); px < tile.cols().end(); ++px) {
+                for (int py = tile.y0; py < tile.y1; ++py)
+                    for (int px = tile.x0; px < tile.x1; ++px) {
                         const Ray ray = pinhole.ray(px, py);
                         const math::Ray<Real> w_ray(Vec3R(ray.origin[0], ray.origin[1], ray.origin[2]),
                                                     Vec3R(ray.dir[0], ray.dir[1], ray.dir[2]));
@@ -183,8 +192,7 @@ VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera&
                             frame.normal[3 * i + a] = len > 0 ? float(sign * n[a] / len) : float(-ray.dir[a]);
                     }
                 hits += tile_hits;
-            },
-            tbb::simple_partitioner());
+            });
         frame.stats.seconds = seconds_since(start);
         frame.stats.rays = uint64_t(W) * H;
         frame.stats.hits = hits;
@@ -192,15 +200,12 @@ VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera&
     t0 = std::chrono::steady_clock::now();
     render_once(r.frame);
     r.first_render_seconds = seconds_since(t0);
-    std::vector<double> seconds;
-    Frame scratch;
-    for (int k = 0; k < std::max(repeats, 1); ++k) {
-        render_once(scratch);
-        seconds.push_back(scratch.stats.seconds);
-    }
-    std::sort(seconds.begin(), seconds.end());
-    r.render_seconds = seconds[seconds.size() / 2];
-    r.frame.stats.seconds = r.render_seconds;
+    r.render = [render_once](Frame* out) {
+        Frame scratch;
+        Frame& f = out ? *out : scratch;
+        render_once(f);
+        return f.stats.seconds;
+    };
     r.ran = true;
     return r;
 }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "octiso/reader.h"
@@ -28,14 +29,16 @@ struct VdbPeerResult {
     uint64_t levelset_bytes = 0;           ///< Grid::memUsage()
     double scale = 0, background = 0;      ///< the chosen s and background
     double first_render_seconds = 0;       ///< wall time of the first frame
-    double render_seconds = 0;             ///< median of the repeated frames
-    Frame frame;                           ///< depth + normals facing the ray
+    Frame frame;                           ///< depth + normals facing the ray (the first frame)
+    /// Renders the frame again (the level set stays alive while this result lives) and returns the
+    /// tile-loop seconds; the caller interleaves these repeats with the other methods.
+    std::function<double(Frame* out)> render;
     /// to-float + level-set preprocessing + one render: what an isovalue change costs.
     double time_to_first_image() const { return to_float_seconds + levelset_seconds + first_render_seconds; }
 };
 
-/// Runs both OpenVDB measurements for isovalue `iso` with `camera`. Never throws for a volume
+/// Runs both OpenVDB measurements for isovalue `iso` with `camera` (one frame; more through `render`). Never throws for a volume
 /// OpenVDB cannot take (anisotropic spacing, iso outside the data): it says so in `skipped`.
-VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera& camera, int repeats);
+VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera& camera);
 
 }  // namespace octiso::bench

@@ -2,10 +2,17 @@
 // on 1..nproc threads at 512^2 and 1024^2, and the load-balance bound of the dynamic tile scheduler
 // on 1..64 workers: 8x8 blocks timed single-threaded, summed into tiles, list-scheduled in TBB's
 // split order (each worker takes the next tile when free: work stealing without overhead); speedup
-// = sum / makespan. A static split into P equal runs of tiles is shown for contrast.
+// = sum / makespan. A static split into P equal runs of tiles is shown for contrast. The model adds
+// what the pure schedule leaves out: the serial per-frame time of render() (measured: call time -
+// tile-loop time) and the machine's own ceiling (a compute-bound loop on 1..nproc threads, which
+// sees shared caches, clocks and other processes). Every simulated figure is labelled simulated.
 #include <time.h>
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
+#include <atomic>
 #include <fstream>
 #include <iostream>
 #include <queue>
@@ -17,6 +24,7 @@
 #include "octiso/error.h"
 #include "octiso/reader.h"
 #include "octiso/render.h"
+#include "octiso/tiles.h"
 #include "octiso/synthetic.h"
 #include "render/pinhole_camera.h"
 #include "render/traverse.h"
@@ -29,30 +37,6 @@ const char* const kScalingUsage =
     "                            [--max-threads N] [--mri FILE] [--quick]\n"
     "  NAME: plume (default), mixing (synthetic N^3, default 256) or mri\n"
     "  --quick: 128^3, images 256 and 512, 2 repeats";
-
-/// Tiles of blocked_range2d(0, H, ts, 0, W, ts) in the order TBB's simple_partitioner produces them
-/// when run serially: split the side that is longer relative to its grain size, at the middle,
-/// left half first (oneTBB blocked_range2d::do_split), until neither side exceeds the grain.
-struct Tile {
-    int y0, y1, x0, x1;
-};
-void tbb_tile_order(int y0, int y1, int x0, int x1, int ts, std::vector<Tile>& out) {
-    const bool rows_divisible = y1 - y0 > ts, cols_divisible = x1 - x0 > ts;
-    if (!rows_divisible && !cols_divisible) {
-        out.push_back({y0, y1, x0, x1});
-        return;
-    }
-    const bool split_cols = (y1 - y0) < (x1 - x0);   // equal grains: the longer side, ties to rows
-    if (split_cols) {
-        const int m = x0 + (x1 - x0) / 2;
-        tbb_tile_order(y0, y1, x0, m, ts, out);
-        tbb_tile_order(y0, y1, m, x1, ts, out);
-    } else {
-        const int m = y0 + (y1 - y0) / 2;
-        tbb_tile_order(y0, m, x0, x1, ts, out);
-        tbb_tile_order(m, y1, x0, x1, ts, out);
-    }
-}
 
 /// Makespan of greedy list scheduling: tiles in order, each to the worker that is free first.
 double list_schedule_makespan(const std::vector<double>& cost, int workers) {
@@ -78,6 +62,32 @@ double static_makespan(const std::vector<double>& cost, int workers) {
         makespan = std::max(makespan, sum);
     }
     return makespan;
+}
+
+/// The machine's ceiling: wall seconds of a compute-bound loop (8 independent FMA chains, no memory
+/// traffic) of fixed length per thread, run on `threads` threads at once in a task arena; the
+/// ceiling speedup at P is P * t(1) / t(P). Median of `repeats` runs.
+double compute_bound_seconds(int threads, int repeats) {
+    std::vector<double> s;
+    for (int r = 0; r < repeats; ++r) {
+        tbb::task_arena arena(threads);
+        std::atomic<double> sink{0};
+        const auto t0 = std::chrono::steady_clock::now();
+        arena.execute([&] {
+            tbb::parallel_for(0, threads, [&](int) {
+                double x[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+                for (int i = 0; i < 20'000'000; ++i)
+                    for (double& v : x) v = v * 0.999999 + 1e-7;
+                double sum = 0;
+                for (double v : x) sum += v;
+                sink = sink + sum;
+            }, tbb::static_partitioner());
+        });
+        s.push_back(seconds_since(t0));
+        if (sink.load() == -1.0) std::cerr << "";   // keep the loop observable
+    }
+    std::sort(s.begin(), s.end());
+    return s[s.size() / 2];
 }
 
 /// CPU seconds of the whole process (all threads, spinning workers included).
@@ -107,8 +117,14 @@ struct Simulated {
     int width = 0, tile = 16;
     uint64_t tiles = 0;
     double sum_seconds = 0, max_tile_seconds = 0;
+    double serial_seconds = 0;   ///< measured per-frame serial time of render() at this size
     std::vector<int> workers;
     std::vector<double> dynamic_speedup, static_speedup;
+    /// (serial + sum) / (serial + makespan): the schedule with the serial per-frame work.
+    std::vector<double> serial_speedup;
+    /// The same with every worker slowed to the machine's measured ceiling efficiency at P (at
+    /// P > nproc the ceiling cannot be measured here and the value at nproc is used, an upper bound).
+    std::vector<double> model_speedup;
 };
 
 /// Seconds of each 8x8 block of the frame (row-major, ceil(W/8) per row), single-threaded on the
@@ -136,13 +152,15 @@ std::vector<double> block_costs(const Octree<T>& tree, const Placement& placemen
     return cost;
 }
 
-/// Costs of the tiles of side `ts` in TBB order: the sum of the 8x8 blocks whose corner lies in them.
+/// Costs of the tiles of render()'s TileGrid of side `ts`, in the order its tile loop hands them
+/// out when run serially (row-major: tile_loop.h splits the tile index range, lowest first): the
+/// sum of the 8x8 blocks whose corner lies in each.
 std::vector<double> tile_costs(const std::vector<double>& blocks, int width, int height, int ts) {
-    std::vector<Tile> tiles;
-    tbb_tile_order(0, height, 0, width, ts, tiles);
+    const TileGrid grid{width, height, ts};
     const int bw = (width + 7) / 8;
     std::vector<double> cost;
-    for (const Tile& t : tiles) {
+    for (int i = 0; i < grid.count(); ++i) {
+        const PixelRect t = grid.rect(i);
         double c = 0;
         for (int by = (t.y0 + 7) / 8; by * 8 < t.y1; ++by)
             for (int bx = (t.x0 + 7) / 8; bx * 8 < t.x1; ++bx) c += blocks[size_t(by) * bw + bx];
@@ -188,6 +206,14 @@ int run_scaling(cli::Args& args) {
     const Dims dims = volume.dims();
     std::cerr << "scaling: " << name << " " << dims.x << "x" << dims.y << "x" << dims.z << ", iso " << iso << "\n";
 
+    // The machine's ceiling on 1..max_threads threads (compute-bound, so the renderer cannot beat it).
+    std::vector<double> ceiling_speedup;   // index P-1
+    {
+        const int ceiling_repeats = quick ? 1 : 3;
+        const double one = compute_bound_seconds(1, ceiling_repeats);
+        for (int p = 1; p <= max_threads; ++p)
+            ceiling_speedup.push_back(p == 1 ? 1.0 : double(p) * one / compute_bound_seconds(p, ceiling_repeats));
+    }
     std::vector<Measured> measured;
     std::vector<Simulated> simulated;
     const std::vector<int> sim_workers = {1, 2, 4, 8, 16, 32, 64};
@@ -220,6 +246,11 @@ int run_scaling(cli::Args& args) {
                     r.cpu_seconds.push_back(process_cpu_seconds() - c0);
                 }
             for (auto& r : rows) measured.push_back(r);
+            // Serial per-frame time: the whole render() call minus its tile loop (one thread).
+            std::vector<double> serial;
+            for (size_t k = 0; k < rows.front().seconds.size(); ++k)
+                serial.push_back(std::max(0.0, rows.front().call_seconds[k] - rows.front().seconds[k]));
+            const double serial_seconds = Measured::median_of(serial);
 
             const std::vector<double> blocks = block_costs(tree, volume.placement(), camera, iso, quick ? 1 : 3);
             for (int ts : {16, 8}) {   // 16: the renderer's tiles; 8: what finer tiles would give
@@ -229,10 +260,16 @@ int run_scaling(cli::Args& args) {
                 const std::vector<double> cost = tile_costs(blocks, w, w, ts);
                 s.tiles = cost.size();
                 for (double c : cost) s.sum_seconds += c, s.max_tile_seconds = std::max(s.max_tile_seconds, c);
+                s.serial_seconds = serial_seconds;
                 for (int p : sim_workers) {
                     s.workers.push_back(p);
-                    s.dynamic_speedup.push_back(s.sum_seconds / list_schedule_makespan(cost, p));
+                    const double makespan = list_schedule_makespan(cost, p);
+                    s.dynamic_speedup.push_back(s.sum_seconds / makespan);
                     s.static_speedup.push_back(s.sum_seconds / static_makespan(cost, p));
+                    s.serial_speedup.push_back((serial_seconds + s.sum_seconds) / (serial_seconds + makespan));
+                    const int q = std::min(p, int(ceiling_speedup.size()));
+                    const double ceiling_eff = ceiling_speedup[size_t(q - 1)] / q;
+                    s.model_speedup.push_back((serial_seconds + s.sum_seconds) / (serial_seconds + makespan / ceiling_eff));
                 }
                 simulated.push_back(s);
             }
@@ -264,14 +301,26 @@ int run_scaling(cli::Args& args) {
     mt.print(std::cout);
     std::cout << "\n";
     mt.print_markdown(std::cout);
-    Table st({"image", "tile", "tiles", "max tile / mean", "P", "dynamic speedup", "dynamic eff.", "static speedup", "static eff."});
+    Table ct({"threads", "compute-bound speedup (measured ceiling)", "ceiling eff."});
+    for (size_t i = 0; i < ceiling_speedup.size(); ++i)
+        ct.add({std::to_string(i + 1), fmt(ceiling_speedup[i], 3), fmt(100.0 * ceiling_speedup[i] / double(i + 1), 1) + " %"});
+    std::cout << "\nmachine ceiling (measured): a compute-bound loop of fixed length per thread\n";
+    ct.print(std::cout);
+    std::cout << "\n";
+    ct.print_markdown(std::cout);
+    Table st({"image", "tile", "tiles", "max tile / mean", "P", "simulated dynamic eff.", "simulated static eff.",
+              "serial s/frame (measured)", "simulated eff. + serial", "simulated eff. + serial + ceiling"});
     for (const auto& s : simulated)
         for (size_t i = 0; i < s.workers.size(); ++i)
             st.add({std::to_string(s.width) + "^2", std::to_string(s.tile), std::to_string(s.tiles),
                     fmt(s.max_tile_seconds / (s.sum_seconds / double(s.tiles)), 2), std::to_string(s.workers[i]),
-                    fmt(s.dynamic_speedup[i], 2), fmt(100.0 * s.dynamic_speedup[i] / s.workers[i], 1) + " %",
-                    fmt(s.static_speedup[i], 2), fmt(100.0 * s.static_speedup[i] / s.workers[i], 1) + " %"});
-    std::cout << "\nsimulated schedule of measured tile costs (load-balance bound, no scheduling overhead)\n";
+                    fmt(100.0 * s.dynamic_speedup[i] / s.workers[i], 1) + " %", fmt(100.0 * s.static_speedup[i] / s.workers[i], 1) + " %",
+                    fmt(s.serial_seconds, 4), fmt(100.0 * s.serial_speedup[i] / s.workers[i], 1) + " %",
+                    fmt(100.0 * s.model_speedup[i] / s.workers[i], 1) + " %"});
+    std::cout << "\nSIMULATED schedule of measured tile costs (no scheduling overhead; the last two columns add the "
+                 "measured serial per-frame time and the measured machine ceiling, which beyond "
+              << ceiling_speedup.size() << " threads is assumed to stay at its " << ceiling_speedup.size()
+              << "-thread value)\n";
     st.print(std::cout);
     std::cout << "\n";
     st.print_markdown(std::cout);
@@ -281,6 +330,7 @@ int run_scaling(cli::Args& args) {
         j.field("machine", machine_description()).field("dataset", name).field("source", volume.source());
         j.key("dims").array(std::vector<uint32_t>{dims.x, dims.y, dims.z});
         j.field("iso", iso).field("repeats", repeats).field("loadavg", load);
+        j.key("ceiling_speedup").array(ceiling_speedup);   // measured, index = threads - 1
         j.key("measured").begin_array();
         for (const auto& m : measured) {
             j.begin_object();
@@ -299,6 +349,9 @@ int run_scaling(cli::Args& args) {
             j.key("workers").array(s.workers);
             j.key("dynamic_speedup").array(s.dynamic_speedup);
             j.key("static_speedup").array(s.static_speedup);
+            j.field("serial_seconds", s.serial_seconds);
+            j.key("serial_speedup").array(s.serial_speedup);
+            j.key("model_speedup").array(s.model_speedup);
             j.end_object();
         }
         j.end_array();

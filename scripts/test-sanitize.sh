@@ -18,4 +18,4 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/scripts/lsan.supp}
 filter=()
 if [[ -n "${OCTISO_SANITIZE_FILTER:-}" ]]; then filter=(-E "$OCTISO_SANITIZE_FILTER"); fi
-ctest --output-on-failure -j "$jobs" "${filter[@]}"
+ctest --no-tests=error --output-on-failure -j "$jobs" "${filter[@]}"

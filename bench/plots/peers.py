@@ -19,7 +19,7 @@ def plot(data, out_png):
                 methods.append(m["method"])
     panels = [("render_seconds", "render s (one frame)"), ("first_image_seconds", "first image after iso change, s"),
               ("bytes", "bytes (MB)")]
-    fig, axes = plt.subplots(1, 3, figsize=(16, 5))
+    fig, axes = plt.subplots(1, 3, figsize=(16, 6))
     width = 0.8 / max(len(methods), 1)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ax, (key, title) in zip(axes, panels):
@@ -51,8 +51,8 @@ def plot(data, out_png):
         ax.set_title(title)
         ax.grid(axis="y", alpha=0.3, which="both")
     fig.legend(handles=[Patch(color=colours[i % len(colours)], label=m) for i, m in enumerate(methods)],
-               loc="lower center", ncol=len(methods), fontsize=8)
+               loc="lower center", ncol=min(len(methods), 4), fontsize=8)
     fig.suptitle(f"octiso vs peers, {data['width']}x{data['height']} primary rays (labels: hit-mask mismatch "
                  f"vs exact reference)", fontsize=10)
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    fig.tight_layout(rect=(0, 0.03 + 0.035 * ((len(methods) + 3) // 4), 1, 1))
     fig.savefig(out_png, dpi=120)

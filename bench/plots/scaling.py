@@ -1,5 +1,6 @@
 """Scaling plot: left, measured parallel efficiency per thread count and image size; right, the
-simulated speedup of the dynamic tile schedule (and a static split) from measured tile costs."""
+simulated speedup of the dynamic tile schedule (and a static split) from measured tile costs, and
+the model that adds the measured serial per-frame time and machine ceiling (all simulated)."""
 import matplotlib.pyplot as plt
 
 
@@ -26,6 +27,9 @@ def plot(data, out_png):
     left.grid(alpha=0.3)
     for s in data["simulated"]:
         right.plot(s["workers"], s["dynamic_speedup"], "o-", label=f"dynamic {s['width']}^2, {s.get('tile', 16)}^2 tiles")
+        if s.get("model_speedup"):
+            right.plot(s["workers"], s["model_speedup"], "d--",
+                       label=f"+ serial + ceiling {s['width']}^2, {s.get('tile', 16)}^2 tiles")
         if s.get("tile", 16) == 16:
             right.plot(s["workers"], s["static_speedup"], "x:", label=f"static {s['width']}^2, {s.get('tile', 16)}^2 tiles")
     top = max(max(s["workers"]) for s in data["simulated"])
@@ -35,7 +39,7 @@ def plot(data, out_png):
     right.set_yscale("log", base=2)
     right.set_xlabel("workers")
     right.set_ylabel("speedup (sum of tile costs / makespan)")
-    right.set_title("simulated schedule of measured tile costs")
+    right.set_title("SIMULATED schedule of measured tile costs")
     right.legend(fontsize=7)
     right.grid(alpha=0.3)
     fig.suptitle(f"{data['dataset']} {'x'.join(map(str, data['dims']))}, iso {data['iso']}; "

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <tbb/parallel_for.h>
 
+#include "octiso/error.h"
 #include "render/pinhole_camera.h"
 
 namespace octiso {
@@ -36,15 +38,22 @@ Frame render_reference(const VolumeView<T>& volume, const Placement& placement, 
 }
 
 ImageError compare_frames(const Frame& frame, const Frame& reference, double voxel) {
+    const bool normals = !frame.normal.empty() && !reference.normal.empty();
+    if (frame.width != reference.width || frame.height != reference.height || frame.depth.size() != reference.depth.size() ||
+        (normals && frame.normal.size() != reference.normal.size()))
+        throw Error("compare_frames", "frames differ in size (" + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
+                                          ", " + std::to_string(frame.depth.size()) + " depths against " +
+                                          std::to_string(reference.width) + "x" + std::to_string(reference.height) + ", " +
+                                          std::to_string(reference.depth.size()) + ")", ErrorKind::Other);
     ImageError e;
     e.pixels = reference.depth.size();
     std::vector<double> depth_err, angle_err;
-    const bool normals = !frame.normal.empty() && !reference.normal.empty();
-    for (size_t i = 0; i < e.pixels && i < frame.depth.size(); ++i) {
+    for (size_t i = 0; i < e.pixels; ++i) {
         const bool a = std::isfinite(frame.depth[i]), b = std::isfinite(reference.depth[i]);
         if (a != b) { ++e.mask_mismatch; continue; }
         if (!a) continue;
         depth_err.push_back(std::abs(double(frame.depth[i]) - double(reference.depth[i])) / voxel);
+        e.depth_above_1e3 += depth_err.back() > 1e-3;
         if (normals) {
             double dot = 0;
             for (int k = 0; k < 3; ++k) dot += double(frame.normal[3 * i + k]) * double(reference.normal[3 * i + k]);

@@ -19,11 +19,13 @@ struct ImageError {
     uint64_t pixels = 0, mask_mismatch = 0, both_hit = 0;
     double mask_mismatch_fraction = 0;
     double depth_median = 0, depth_p99 = 0, depth_max = 0;   ///< voxel units
+    uint64_t depth_above_1e3 = 0;                            ///< pixels both hit, depth error > 1e-3 voxel
     double normal_median_deg = 0, normal_max_deg = 0;        ///< only where both frames have normals
 };
 
 /// `frame` against `reference`; both need depth, normals are compared when both have them.
-/// `voxel` is the smallest spacing component (CONVENTIONS 2b).
+/// `voxel` is the smallest spacing component (CONVENTIONS 2b). Throws Error when the two frames
+/// differ in size (width, height, depth or normal pixels): there is no pixel-by-pixel answer then.
 ImageError compare_frames(const Frame& frame, const Frame& reference, double voxel);
 
 }  // namespace octiso

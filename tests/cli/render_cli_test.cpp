@@ -13,6 +13,7 @@
 #include "test_util/run_shell.h"
 #include "octiso/image.h"
 #include "test_util/scratch_dir.h"
+#include "test_util/skip.h"
 
 namespace octiso::test {
 namespace {
@@ -35,7 +36,9 @@ int run(const std::string& tool, const std::string& args, std::string* out = nul
 class RenderCli : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!fs::exists(kTools + "/octiso-render") || !fs::exists(kTools + "/octiso-convert")) GTEST_SKIP() << "tools not built";
+        if (!fs::exists(kTools + "/octiso-render") || !fs::exists(kTools + "/octiso-convert")) {
+            OCTISO_SKIP("tools not built");
+        }
         ASSERT_EQ(run("octiso-convert", "--synthetic sphere:24 -o '" + oct_ + "'"), 0);
         ASSERT_EQ(run("octiso-convert", "--synthetic marschner-lobb:20 --iso-range 0.3,0.7 -o '" + ranged_ + "'"), 0);
     }
@@ -103,7 +106,7 @@ TEST_F(RenderCli, BadInputsExitTwoAndLeaveNoOutput) {
     for (const std::string& args : bad) {
         std::string err;
         EXPECT_EQ(run("octiso-render", args, nullptr, &err), 2) << args;
-        EXPECT_EQ(out.entries(), 0u) << "no output, no temporary left: " << args;
+        EXPECT_EQ(out.entries().size(), 0u) << "no output, no temporary left: " << args;
         EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << "one line on stderr: " << err;
     }
 }

@@ -26,6 +26,7 @@
 #include "octiso/render.h"
 #include "octree/octree_test_util.h"
 #include "reference/reference_render.h"
+#include "test_util/skip.h"
 
 namespace octiso::test {
 namespace {
@@ -121,7 +122,9 @@ class ExtremeCli : public ::testing::Test {
 protected:
     void SetUp() override {
         for (const char* tool : {"octiso-convert", "octiso-info", "octiso-render"})
-            if (!fs::exists(kTools + "/" + tool)) GTEST_SKIP() << tool << " not built";
+            if (!fs::exists(kTools + "/" + tool)) {
+                OCTISO_SKIP(tool << " not built");
+            }
     }
 };
 
@@ -137,7 +140,7 @@ template <typename T> void check_non_finite_refused_and_replaced(const std::stri
         std::string text;
         EXPECT_EQ(run(convert() + raw + " --dims 5,4,3 --type " + type + " -o " + out, &text), 2) << text;
         EXPECT_FALSE(fs::exists(out));
-        EXPECT_EQ(dir.entries(), 1u) << "no output and no temporary left behind";
+        EXPECT_EQ(dir.entries().size(), 1u) << "no output and no temporary left behind";
         EXPECT_NE(text.find(raw), std::string::npos) << "the message names the file: " << text;
         EXPECT_NE(text.find(std::isnan(bad) ? "NaN" : "infinite"), std::string::npos) << text;
         EXPECT_NE(text.find("--nan-as"), std::string::npos) << "the message names the way out: " << text;
@@ -174,7 +177,7 @@ TEST_F(ExtremeCli, VoxelCountsBeyond32BitsAreRefusedCleanly) {
             << c.dims << ": " << text;
         EXPECT_NE(text.find(c.expect), std::string::npos) << c.dims << ": " << text;
         EXPECT_FALSE(fs::exists(out));
-        EXPECT_EQ(dir.entries(), 1u);
+        EXPECT_EQ(dir.entries().size(), 1u);
     }
 }
 

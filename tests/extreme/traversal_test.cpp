@@ -250,16 +250,26 @@ std::vector<TestRay> grazing_rays(Dims dims) {
     return rays;
 }
 
-template <typename T> void run_all(const DenseVolume<T>& v, double iso, const char* what) {
+/// The excused rays of one ray set, pinned to what was measured (not a share that may be used up):
+/// ill-conditioned (only non-strict rays can be, see TestRay) and point touches of the data box
+/// (the known deviation in run_rays). Any change in either direction fails and is looked at.
+struct Excused {
+    uint64_t ill_conditioned = 0, point_touches = 0;
+};
+
+template <typename T>
+void run_all(const DenseVolume<T>& v, double iso, const char* what, Excused axis = {}, Excused special = {},
+             Excused grazing = {}) {
     const auto data = build_octree(v.view(), {});
     Watchdog dog(std::chrono::seconds(240));
-    const struct { const char* name; std::vector<TestRay> rays; } sets[] = {
-        {"axis", axis_rays(v.dims)}, {"special", special_rays(v.dims, 7)}, {"grazing", grazing_rays(v.dims)}};
+    const struct { const char* name; std::vector<TestRay> rays; Excused excused; } sets[] = {
+        {"axis", axis_rays(v.dims), axis}, {"special", special_rays(v.dims, 7), special}, {"grazing", grazing_rays(v.dims), grazing}};
     for (const auto& s : sets) {
         const Result r = run_rays(v, data.view(), iso, s.rays, dog);
         SCOPED_TRACE(std::string(what) + " " + s.name);
         EXPECT_EQ(r.mismatches, 0u) << r.mismatches << " of " << r.rays << "; first: " << r.first_mismatch;
-        EXPECT_LE(r.ill_conditioned + r.point_touches, r.rays / 20);
+        EXPECT_EQ(r.ill_conditioned, s.excused.ill_conditioned) << "of " << r.rays << " rays";
+        EXPECT_EQ(r.point_touches, s.excused.point_touches) << "of " << r.rays << " rays";
         ::testing::Test::RecordProperty(std::string(what) + " " + s.name + " ill_conditioned", int(r.ill_conditioned));
         ::testing::Test::RecordProperty(std::string(what) + " " + s.name + " point_touches", int(r.point_touches));
         EXPECT_GT(r.hits, r.rays / 10) << "the rays must actually meet the surface";
@@ -271,8 +281,12 @@ TEST(TraversalRobustness, BallAcrossEveryMidPlane) { run_all(ball({33, 33, 33}),
 TEST(TraversalRobustness, BallInNonCubicBoxWithPadding) { run_all(ball({33, 20, 26}), 40.0, "ball 33x20x26"); }
 
 TEST(TraversalRobustness, LatticeRootsOnVerticesEdgesAndFaces) {
-    run_all(lattice({33, 33, 33}), 30.0, "lattice iso 30");
-    run_all(lattice({17, 33, 9}), 20.0, "lattice iso 20");
+    // Roots on lattice vertices, edges and faces: the only sets with excused rays. Measured:
+    // iso 30: 40 of 3456 axis rays and 6 of 700 grazing rays ill-conditioned (1e-12 off a face),
+    // 75 of 1908 special rays touch the data box at one point where f == iso; iso 20: 52 of 1728
+    // axis rays ill-conditioned.
+    run_all(lattice({33, 33, 33}), 30.0, "lattice iso 30", {40, 0}, {0, 75}, {6, 0});
+    run_all(lattice({17, 33, 9}), 20.0, "lattice iso 20", {52, 0});
 }
 
 TEST(TraversalRobustness, ConstantVolumeEqualToIsoIsHitWhereTheRayEnters) {
@@ -333,7 +347,7 @@ TEST(TraversalRobustness, FramesWithEyesOnMidPlanesAndBoxCorners) {
             const ImageError e = compare_frames(f, ref, 1.0);
             SCOPED_TRACE("camera " + std::to_string(i) + (embree ? " embree" : " direct"));
             EXPECT_EQ(e.mask_mismatch, 0u);
-            EXPECT_LE(e.depth_p99, 1e-3);
+            EXPECT_EQ(e.depth_above_1e3, 0u) << "depth max " << e.depth_max << " voxel";
             EXPECT_GT(e.both_hit, 100u);
         }
         ++i;

@@ -8,6 +8,7 @@
 
 #include "test_util/run_shell.h"
 #include "format/oct_test_util.h"
+#include "test_util/skip.h"
 
 namespace octiso::test {
 namespace {
@@ -20,7 +21,9 @@ int run(const std::string& cmd, std::string& out) { return run_shell(cmd, &out);
 class InfoCli : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!std::filesystem::exists(kInfo)) GTEST_SKIP() << kInfo << " not built";
+        if (!std::filesystem::exists(kInfo)) {
+            OCTISO_SKIP(kInfo << " not built");
+        }
     }
 };
 

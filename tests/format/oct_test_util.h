@@ -1,4 +1,4 @@
-// Helpers for the .oct suites: per-test scratch directories, writing a built octree to a file, and
+// Helpers for the .oct suites (scratch directories come from test_util/scratch_dir.h): writing a built octree to a file, and
 // OctBytes, an in-memory copy of a .oct file that tests corrupt field by field and re-checksum so
 // that the loader's structural checks (not only its checksums) are what rejects the result.
 #pragma once
@@ -18,32 +18,9 @@
 #include "octiso/build.h"
 #include "octiso/oct_file.h"
 #include "octree/octree_test_util.h"
+#include "test_util/scratch_dir.h"
 
 namespace octiso::test {
-
-/// A fresh empty directory for the running test, removed by the destructor.
-class ScratchDir {
-public:
-    ScratchDir() {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        std::string name = std::string(info->test_suite_name()) + "_" + info->name();
-        for (char& c : name)
-            if (c == '/') c = '_';
-        dir_ = std::filesystem::temp_directory_path() / ("octiso-" + std::to_string(::getpid()) + "-" + name);
-        std::filesystem::remove_all(dir_);
-        std::filesystem::create_directories(dir_);
-    }
-    ~ScratchDir() { std::filesystem::remove_all(dir_); }
-    std::string file(const std::string& name) const { return (dir_ / name).string(); }
-    std::vector<std::string> entries() const {
-        std::vector<std::string> out;
-        for (const auto& e : std::filesystem::directory_iterator(dir_)) out.push_back(e.path().filename().string());
-        return out;
-    }
-
-private:
-    std::filesystem::path dir_;
-};
 
 inline OctInfo info_for(ScalarType type, Dims dims) {
     OctInfo info;

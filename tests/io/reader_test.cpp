@@ -21,6 +21,7 @@
 #include "test_util/scratch_dir.h"
 #include "octiso/error.h"
 #include "octiso/reader.h"
+#include "test_util/skip.h"
 
 namespace octiso::test {
 namespace {
@@ -368,7 +369,9 @@ TEST(VtkReader, MalformedFilesNameTheFile) {
 
 TEST(VtkReader, RealNiftiTemplate) {
     const std::string path = "/usr/share/mricron/templates/ch2.nii.gz";
-    if (!fs::exists(path)) GTEST_SKIP() << path << " not installed";
+    if (!fs::exists(path)) {
+        OCTISO_SKIP(path << " not installed");
+    }
     const LoadedVolume v = open_volume(path, {});
     EXPECT_EQ(v.format(), VolumeFormat::nifti);
     EXPECT_GT(v.dims().voxels(), 1000000u);

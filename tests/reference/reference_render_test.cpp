@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "octiso/error.h"
 #include "reference/reference_render.h"
 
 namespace octiso::test {
@@ -31,6 +32,27 @@ TEST(CompareFrames, CountsMaskMismatchesAndMeasuresDepthInVoxels) {
     EXPECT_DOUBLE_EQ(e.depth_median, 1.0);
     EXPECT_DOUBLE_EQ(e.depth_max, 2.0);
     EXPECT_DOUBLE_EQ(e.depth_p99, 2.0);
+    EXPECT_EQ(e.depth_above_1e3, 2u);                      // the pixels 1 and 2 voxels off
+}
+
+TEST(CompareFrames, CountsDepthErrorsAboveAThousandthOfAVoxel) {
+    const Frame ref = frame_of({1.0f, 1.0f, 1.0f, 1.0f});
+    const Frame got = frame_of({1.0f, 1.0f + 0.5e-3f, 1.0f + 2e-3f, 1.0f - 4e-3f});
+    const ImageError e = compare_frames(got, ref, 1.0);
+    EXPECT_EQ(e.both_hit, 4u);
+    EXPECT_EQ(e.depth_above_1e3, 2u);
+}
+
+TEST(CompareFrames, FramesOfDifferentSizesAreRefused) {
+    // A shorter frame must not compare as its common prefix (that could hide a whole missing row).
+    const Frame ref = frame_of({1.0f, 2.0f, 3.0f});
+    EXPECT_THROW(compare_frames(frame_of({1.0f, 2.0f}), ref, 1.0), Error);
+    EXPECT_THROW(compare_frames(ref, frame_of({1.0f, 2.0f}), 1.0), Error);
+    Frame transposed = ref;
+    transposed.width = 1, transposed.height = 3;   // same pixel count, other shape
+    EXPECT_THROW(compare_frames(transposed, ref, 1.0), Error);
+    Frame short_normals = frame_of({1.0f, 2.0f, 3.0f}, {0, 0, 1, 0, 0, 1});
+    EXPECT_THROW(compare_frames(short_normals, frame_of({1.0f, 2.0f, 3.0f}, {0, 0, 1, 0, 0, 1, 0, 0, 1}), 1.0), Error);
 }
 
 TEST(CompareFrames, NormalAngleInDegrees) {

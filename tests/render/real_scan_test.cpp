@@ -12,6 +12,7 @@
 #include "octiso/reader.h"
 #include "octiso/render.h"
 #include "reference/reference_render.h"
+#include "test_util/skip.h"
 
 namespace octiso::test {
 namespace {
@@ -30,13 +31,16 @@ void expect_agreement(const Octree<T>& tree, const VolumeView<T>& dense, const P
     const double voxel = std::min({placement.spacing[0], placement.spacing[1], placement.spacing[2]});
     const ImageError e = compare_frames(frame, ref, voxel);
     SCOPED_TRACE(::testing::Message() << "iso " << iso << " eye " << cam.eye[0] << "," << cam.eye[1] << "," << cam.eye[2]);
-    EXPECT_LE(e.mask_mismatch_fraction, 0.0005) << e.mask_mismatch << " pixels";
-    EXPECT_LE(e.depth_p99, 1e-3);
+    EXPECT_EQ(e.mask_mismatch, 0u) << e.mask_mismatch << " of " << e.pixels << " pixels differ";
+    EXPECT_LE(e.depth_above_1e3, 4u) << "pixels with depth error > 1e-3 voxel (max " << e.depth_max << ")";
+    EXPECT_LE(e.depth_max, 0.018);   // the measured bar of render_test_util.h (Neubauer N=5)
     EXPECT_GT(e.both_hit, uint64_t(cam.width) * cam.height / 20) << "the surface must fill part of the view";
 }
 
 TEST(RealScan, Ch2AnatomyU8AtSeveralIsovaluesAndCameras) {
-    if (!std::filesystem::exists(kScan)) GTEST_SKIP() << kScan << " not installed";
+    if (!std::filesystem::exists(kScan)) {
+        OCTISO_SKIP(kScan << " not installed");
+    }
     const LoadedVolume vol = open_volume(kScan, {});
     ASSERT_EQ(vol.type(), ScalarType::u8);
     const VolumeView<uint8_t> dense = vol.view<uint8_t>();
@@ -54,7 +58,9 @@ TEST(RealScan, Ch2AnatomyU8AtSeveralIsovaluesAndCameras) {
 }
 
 TEST(RealScan, Ch2AsFloatThroughTheOctFile) {
-    if (!std::filesystem::exists(kScan)) GTEST_SKIP() << kScan << " not installed";
+    if (!std::filesystem::exists(kScan)) {
+        OCTISO_SKIP(kScan << " not installed");
+    }
     const LoadedVolume vol = open_volume(kScan, {});
     const VolumeView<uint8_t> bytes = vol.view<uint8_t>();
     std::vector<float> values(bytes.dims.voxels());

@@ -74,12 +74,25 @@ ImageError error_against_reference(const Frame& frame, const VolumeView<T>& dens
     return compare_frames(frame, ref, std::min({placement.spacing[0], placement.spacing[1], placement.spacing[2]}));
 }
 
-/// The renderer tests' bar: hit-mask agreement >= 99.95 %, depth p99 <= 1e-3 voxel, and a view
-/// that actually shows the surface.
-inline void expect_agreement(const ImageError& e, const std::string& what) {
+/// What the default root finder (Neubauer, 5 Illinois steps) achieves, measured over all 230
+/// agreement frames of the render and macrocell suites (1600 to 3136 pixels each): at most 4 pixels
+/// of a frame have depth off by more than 1e-3 voxel, the worst 0.0172 voxel (noise 37x30x33 u8,
+/// OctreeOverArrayData). They are the finder's: the same frames rendered with RootFinder::exact
+/// have none (RenderAgreementFields checks that on its cases).
+struct DepthBar {
+    uint64_t max_above_1e3 = 4;    ///< pixels with depth error > 1e-3 voxel
+    double max_voxels = 0.018;     ///< the largest depth error
+};
+inline constexpr DepthBar kExactFinderBar{0, 1e-3};
+
+/// The renderer tests' bar, which is what the renderer achieves, not a tolerance it may use up:
+/// the same hit mask as the exact reference (the reference marks no pixel as ambiguous, so every
+/// mismatch counts), the depth bar above, and a view that actually shows the surface.
+inline void expect_agreement(const ImageError& e, const std::string& what, DepthBar bar = {}) {
     SCOPED_TRACE(what);
-    EXPECT_LE(double(e.mask_mismatch), 0.0005 * double(e.pixels)) << e.mask_mismatch << " of " << e.pixels << " pixels differ";
-    EXPECT_LE(e.depth_p99, 1e-3) << "depth p99 in voxels";
+    EXPECT_EQ(e.mask_mismatch, 0u) << e.mask_mismatch << " of " << e.pixels << " pixels differ";
+    EXPECT_LE(e.depth_above_1e3, bar.max_above_1e3) << "pixels with depth error > 1e-3 voxel (p99 " << e.depth_p99 << ")";
+    EXPECT_LE(e.depth_max, bar.max_voxels) << "largest depth error in voxels";
     EXPECT_GT(e.both_hit, 0u) << "the view must actually show the surface";
 }
 

@@ -20,6 +20,7 @@
 #include "octiso/render.h"
 #include "octiso/synthetic.h"
 #include "util/process_memory.h"
+#include "test_util/skip.h"
 
 namespace octiso::test {
 namespace {
@@ -51,7 +52,9 @@ class SeriesCli : public ::testing::Test {
 protected:
     void SetUp() override {
         for (const char* tool : {"octiso-convert", "octiso-info", "octiso-render"})
-            if (!fs::exists(kTools + "/" + tool)) GTEST_SKIP() << tool << " not built";
+            if (!fs::exists(kTools + "/" + tool)) {
+                OCTISO_SKIP(tool << " not built");
+            }
     }
 };
 

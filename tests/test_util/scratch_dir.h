@@ -1,13 +1,16 @@
 // ScratchDir: a fresh directory under the system temp dir for one test, removed with everything
 // in it when the test ends. entries() lets CLI tests assert that a failed run left nothing behind.
+// The one ScratchDir of the test binary (every suite includes this header; a second class of the
+// same name elsewhere would be an ODR violation).
 #pragma once
 
 #include <unistd.h>
 
 #include <filesystem>
-#include <iterator>
+#include <algorithm>
 #include <string>
 #include <system_error>
+#include <vector>
 
 namespace octiso::test {
 
@@ -28,9 +31,12 @@ public:
 
     const std::filesystem::path& path() const { return path_; }
     std::string file(const std::string& name) const { return (path_ / name).string(); }
-    /// Number of entries in the directory (outputs, and any temporaries a tool left behind).
-    size_t entries() const {
-        return size_t(std::distance(std::filesystem::directory_iterator(path_), std::filesystem::directory_iterator()));
+    /// Names of the entries in the directory (outputs, and any temporaries a tool left behind), sorted.
+    std::vector<std::string> entries() const {
+        std::vector<std::string> out;
+        for (const auto& e : std::filesystem::directory_iterator(path_)) out.push_back(e.path().filename().string());
+        std::sort(out.begin(), out.end());
+        return out;
     }
 
 private:
