@@ -168,7 +168,7 @@ TEST(Convert, MismatchedStepIsRefusedBeforeAnythingIsWritten) {
         f << "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 12 5 4\nencoding: raw\n\n";
         f.write(reinterpret_cast<const char*>(u8.data()), std::streamsize(u8.size()));
     }
-    const size_t before = dir.entries();
+    const std::vector<std::string> before = dir.entries();   // sorted names
     const std::string out = dir.file("series.oct");
     const struct { const char* bad; const char* problem; } cases[] = {
         {"wide.nrrd", "dims differ from the first step (expected 12x5x4, found 13x5x4)"},
