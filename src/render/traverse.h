@@ -25,6 +25,7 @@
 
 #include "octiso/octree.h"
 #include "render/cell.h"
+#include "render/cell_dda.h"
 #include "render/cell_hit.h"
 #include "math/ray.h"
 #include "render/roots.h"
@@ -180,56 +181,27 @@ private:
         return ti1 < t1 && walk_cells(w, co, side, ti1, t1, gather);
     }
 
-    /// DDA over the cells of the box [lo, lo + side)^3 that the ray crosses on [t0, t1), in order.
-    /// Each data cell gets the half-open piece [t_in, t_out) (closed at the data exit); `gather`
-    /// fills its 8 corners. Returns true at the first hit.
+    /// The cells of the box [lo, lo + side)^3 that the ray crosses on [t0, t1), in order, by the
+    /// one cell DDA (cell_dda.h). Each data cell gets the half-open piece [t_in, t_out) (closed at
+    /// the data exit); `gather` fills its 8 corners. Cells of the box beyond the data (padding)
+    /// are stepped over. Returns true at the first hit.
     template <class Gather>
     bool walk_cells(Walk& w, const Coord& lo, uint32_t side, double t0, double t1, Gather&& gather) const {
-        const IndexRay& r = w.ray;
-        const uint32_t box_lo[3] = {lo.x, lo.y, lo.z};
         const Dims dims = tree_.dims();
-        const uint32_t last_cell[3] = {dims.x - 2, dims.y - 2, dims.z - 2};
-        int64_t cell[3];
-        for (int a = 0; a < 3; ++a) {
-            const double p = r.origin[a] + t0 * r.dir[a];
-            int64_t i = int64_t(std::floor(p));
-            if (r.dir[a] == 0 && p == scene_.box_hi[a]) i = int64_t(last_cell[a]);   // lying in the top face
-            const int64_t b0 = box_lo[a], b1 = int64_t(box_lo[a]) + side - 1;
-            i = std::clamp(i, b0, b1);
-            // Settle rounding of p at a cell face with the same plane times the DDA steps on.
-            if (r.dir[a] > 0) {
-                if (i < b1 && r.plane_t(a, double(i + 1)) <= t0) ++i;
-                else if (i > b0 && r.plane_t(a, double(i)) > t0) --i;
-            } else if (r.dir[a] < 0) {   // cell i holds [plane_t(i+1), plane_t(i))
-                if (i > b0 && r.plane_t(a, double(i)) <= t0) --i;
-                else if (i < b1 && r.plane_t(a, double(i + 1)) > t0) ++i;
-            }
-            cell[a] = i;
-        }
-        double t_cur = t0;
-        double corner[8];
-        for (;;) {
-            double t_face[3];
-            for (int a = 0; a < 3; ++a)
-                t_face[a] = r.dir[a] > 0 ? r.plane_t(a, double(cell[a] + 1))
-                          : r.dir[a] < 0 ? r.plane_t(a, double(cell[a]))
-                                         : std::numeric_limits<double>::infinity();
-            int axis = 0;
-            if (t_face[1] < t_face[axis]) axis = 1;
-            if (t_face[2] < t_face[axis]) axis = 2;
-            const double t_out = std::min(t_face[axis], t1);
-            const bool in_data = cell[0] <= last_cell[0] && cell[1] <= last_cell[1] && cell[2] <= last_cell[2];
-            const bool closed_end = t_out == w.t_exit;
-            if (in_data && (t_out > t_cur || closed_end)) {
-                const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
-                gather(v, corner);
-                if (test_cell(w, v, corner, t_cur, t_out, closed_end)) return true;
-            }
-            if (t_face[axis] >= t1) return false;
-            t_cur = std::max(t_cur, t_face[axis]);
-            cell[axis] += r.dir[axis] > 0 ? 1 : -1;
-            if (cell[axis] < int64_t(box_lo[axis]) || cell[axis] >= int64_t(box_lo[axis]) + side) return false;
-        }
+        const int64_t last_cell[3] = {int64_t(dims.x) - 2, int64_t(dims.y) - 2, int64_t(dims.z) - 2};
+        const DdaBox box{{lo.x, lo.y, lo.z},
+                         {int64_t(lo.x) + side, int64_t(lo.y) + side, int64_t(lo.z) + side},
+                         {last_cell[0], last_cell[1], last_cell[2]},
+                         scene_.box_hi};
+        return walk_units(w.ray, UnitCells{}, box, t0, t1, w.t_exit,
+                          [&](const int64_t cell[3], double t_in, double t_out, bool closed_end) {
+                              if (cell[0] > last_cell[0] || cell[1] > last_cell[1] || cell[2] > last_cell[2])
+                                  return false;
+                              const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
+                              double corner[8];
+                              gather(v, corner);
+                              return test_cell(w, v, corner, t_in, t_out, closed_end);
+                          });
     }
 
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
