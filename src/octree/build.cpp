@@ -119,21 +119,9 @@ public:
 
     /// A node at depth dmax-2: 4^3 voxels in 8 blocks of 2^3, each a scalar leaf or a cap.
     Summary<T> build_cap_parent(Coord o, Sink<T>& sink) const {
-        // 1. Load the 5^3 neighbourhood from o, coordinates clamped into the data. Clamped
-        //    positions replicate the border: they fill padding slots of caps and are never
-        //    counted in a range, because the extents below stop at the data.
+        // 1. The 5^3 neighbourhood from o, clamped into the data (summary.h).
         T L[5][5][5];
-        uint32_t xs[5], ys[5], zs[5];
-        for (uint32_t i = 0; i < 5; ++i) {
-            xs[i] = std::min(o.x + i, dims_.x - 1);
-            ys[i] = std::min(o.y + i, dims_.y - 1);
-            zs[i] = std::min(o.z + i, dims_.z - 1);
-        }
-        for (int z = 0; z < 5; ++z)
-            for (int y = 0; y < 5; ++y) {
-                const uint64_t row = v_.index(0, ys[y], zs[z]);
-                for (int x = 0; x < 5; ++x) L[z][y][x] = v_.load(row + xs[x]);
-            }
+        detail::load_neighbourhood(o, dims_, [this](uint32_t x, uint32_t y, uint32_t z) { return v_.at(x, y, z); }, L);
 
         // 2. Each block: a scalar leaf or a cap (summary.h).
         Summary<T> ch[8];

@@ -202,15 +202,7 @@ private:
 
     Summary<T> build_cap_parent(Coord o) {
         T L[5][5][5];
-        uint32_t xs[5], ys[5], zs[5];
-        for (uint32_t i = 0; i < 5; ++i) {
-            xs[i] = std::min(o.x + i, dims_.x - 1);
-            ys[i] = std::min(o.y + i, dims_.y - 1);
-            zs[i] = std::min(o.z + i, dims_.z - 1);
-        }
-        for (int z = 0; z < 5; ++z)
-            for (int y = 0; y < 5; ++y)
-                for (int x = 0; x < 5; ++x) L[z][y][x] = f_.value<T>(xs[x], ys[y], zs[z]);
+        detail::load_neighbourhood(o, dims_, [this](uint32_t x, uint32_t y, uint32_t z) { return f_.value<T>(x, y, z); }, L);
         Summary<T> ch[8];
         const uint64_t start = caps_.size();
         detail::cap_parent_children(
