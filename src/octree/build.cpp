@@ -31,6 +31,7 @@
 #include "octiso/error.h"
 #include "octree/prepare.h"
 #include "octree/summary.h"
+#include "util/check.h"
 
 namespace octiso {
 
@@ -197,6 +198,9 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
         return builder.combine(d, ch, start, top);
     };
     if (k > 0) descend(descend, 0, Coord{});
+    // The top must consume every piece in the order they were cut, or child_start at depth k-1
+    // would point at another piece's root.
+    OCTISO_CHECK(k == 0 || next_piece == origins.size(), next_piece, " of ", origins.size(), " pieces consumed");
 
     // 3. Concatenate depth by depth. Depths below k come from `top` alone. Freed piece memory is
     //    handed back every few pieces, so peak memory stays near input + output.
@@ -211,6 +215,11 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
         else for (auto& s : sinks) parts.push_back(&s);
         uint64_t total = 0;
         for (auto* p : parts) total += p->nodes[size_t(d)].size();
+        // Children at depth d+1, as they will be concatenated (before this depth's moves free them).
+        uint64_t next_total = 0;
+        if (d + 1 == dmax - 1) for (auto& s : sinks) next_total += s.caps.size();
+        else if (d + 1 < k) next_total = top.nodes[size_t(d + 1)].size();
+        else for (auto& s : sinks) next_total += s.nodes[size_t(d + 1)].size();
         out.nodes[size_t(d)] = UninitArray<InteriorNode<T>>::make(total);
         uint64_t at = 0, child_offset = 0;
         for (auto* p : parts) {
@@ -222,8 +231,14 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
                         throw Error(options.source_name, "octree too large: more than 2^32 nodes at depth " +
                                                              std::to_string(d + 1) + " (32-bit child indices)");
                     n.child_start = uint32_t(global);
+                    OCTISO_CHECK(global + uint64_t(std::popcount(unsigned(n.child_mask))) <= next_total,
+                                 "depth ", d, ": children from ", global, " past ", next_total, " at depth ", d + 1);
                 }
                 child_offset += d + 1 == dmax - 1 ? p->caps.size() : p->nodes[size_t(d + 1)].size();
+            } else {
+                for (const auto& n : v)
+                    OCTISO_CHECK(uint64_t(n.child_start) + uint64_t(std::popcount(unsigned(n.child_mask))) <= next_total,
+                                 "depth ", d, ": children from ", n.child_start, " past ", next_total, " at depth ", d + 1);
             }
             out.stats.scalar_leaves_per_depth[size_t(d)] += p->leaves[size_t(d)];
             move_into(out.nodes[size_t(d)], at, v);

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "octiso/error.h"
+#include "util/check.h"
 
 namespace octiso {
 
@@ -93,6 +94,14 @@ public:
 
     OctreeData<T> run() {
         build(0, Coord{});
+        // Every stored node's children must lie in the next depth's array (the loader would refuse
+        // the file; an in-memory octree would be traversed out of bounds).
+        for (int d = 0; d <= dmax_ - 2; ++d) {
+            const uint64_t next = d + 1 == dmax_ - 1 ? caps_.size() : nodes_[size_t(d + 1)].size();
+            for (const InteriorNode<T>& n : nodes_[size_t(d)])
+                OCTISO_CHECK(uint64_t(n.child_start) + uint64_t(std::popcount(unsigned(n.child_mask))) <= next,
+                             "depth ", d, ": children from ", n.child_start, " past ", next, " at depth ", d + 1);
+        }
         OctreeData<T> out;
         out.dims = dims_;
         out.dmax = dmax_;

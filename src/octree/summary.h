@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "octiso/octree.h"
+#include "util/check.h"
 
 namespace octiso::detail {
 
@@ -84,6 +85,7 @@ bool fold_children(int d, const Summary<T>* ch, uint64_t start, const Mergeable&
 /// border. They fill padding slots of caps and never enter a range, because the extents of
 /// cap_parent_children stop at the data. `voxel(x, y, z) -> T` reads one data voxel.
 template <typename T, class Voxel> void load_neighbourhood(Coord o, Dims dims, const Voxel& voxel, T (&L)[5][5][5]) {
+    OCTISO_DCHECK(o.x < dims.x && o.y < dims.y && o.z < dims.z, "cap parent (", o.x, ",", o.y, ",", o.z, ") outside the data");
     uint32_t xs[5], ys[5], zs[5];
     for (uint32_t i = 0; i < 5; ++i) {
         xs[i] = std::min(o.x + i, dims.x - 1);

@@ -29,6 +29,7 @@
 #include "render/cell_hit.h"
 #include "math/ray.h"
 #include "render/roots.h"
+#include "util/check.h"
 
 namespace octiso {
 
@@ -43,7 +44,9 @@ template <typename T, class Finder, class Corners = OctreeCornerSource> class Oc
 public:
     OctreeTracer(const Octree<T>& tree, const Placement& placement, const double* isovalues, int iso_count,
                  const Finder& finder, const Corners& corners = Corners{})
-        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), finder_(finder), corners_(corners) {}
+        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), finder_(finder), corners_(corners) {
+        OCTISO_CHECK(tree.dmax() >= 2 && tree.dmax() < kMaxDepth, "dmax ", tree.dmax());
+    }
 
     /// First hit along the world ray; the normal is computed only if `want_normal`.
     /// Thread-safe: all per-ray state lives on the caller's stack.
@@ -74,6 +77,8 @@ private:
     // and reloaded as a 64-bit register pair, a store-forwarding stall that cost 18 % of node()
     // (perf annotate, plume 256^3 at 1024^2).
     bool node(Walk& w, int d, uint32_t index, const Coord& o, double t0, double t1) const {
+        OCTISO_DCHECK(d >= 0 && d <= tree_.dmax() - 2, "interior depth ", d, ", dmax ", tree_.dmax());
+        OCTISO_DCHECK(index < tree_.node_count(d), "node ", index, " of ", tree_.node_count(d), " at depth ", d);
         w.trace[d] = index;
         const InteriorNode<T>& n = tree_.node(d, index);
         const uint32_t half = tree_.child_bit(d);
@@ -112,6 +117,7 @@ private:
     }
 
     bool cap(Walk& w, uint32_t cap_index, const Coord& co, double t0, double t1) const {
+        OCTISO_DCHECK(cap_index < tree_.cap_count(), "cap ", cap_index, " of ", tree_.cap_count());
         w.trace[tree_.dmax() - 1] = cap_index;
         const Cap<T>& cap = tree_.cap(cap_index);
         // The forward neighbour blocks (2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), r = 1..7) are each a
@@ -197,6 +203,7 @@ private:
                           [&](const int64_t cell[3], double t_in, double t_out, bool closed_end) {
                               if (cell[0] > last_cell[0] || cell[1] > last_cell[1] || cell[2] > last_cell[2])
                                   return false;
+                              OCTISO_DCHECK(cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0, "cell below the data box");
                               const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
                               double corner[8];
                               gather(v, corner);
