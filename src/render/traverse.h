@@ -16,6 +16,8 @@
 // (measured by `octiso-bench grid`: +3-5 % frames/s on octree data, BENCHMARKS.md, grid section).
 // The corner source is a policy only for the grid benchmark's "octree over array data" variant
 // (Knoll 2006 Table 3); with the default, OctreeCornerSource, the policy costs nothing.
+// The recorder is a policy only for `--debug-pixel` (octiso/debug_trace.h): with the default,
+// NoRecorder, every recording call sits behind `if constexpr (Recorder::kOn)` and is not compiled.
 #pragma once
 
 #include <algorithm>
@@ -38,13 +40,22 @@ namespace octiso {
 /// corner read (e.g. ArrayCorners<T> in src/reference/macrocell.h); the octree then only culls.
 struct OctreeCornerSource {};
 
-template <typename T, class Finder, class Corners = OctreeCornerSource> class OctreeTracer {
+/// The default recorder: records nothing. A recording type sets kOn = true and provides the
+/// const calls of PixelTraceRecorder (src/render/debug_trace.cpp): clip, enter_node, cull,
+/// scalar_leaf, enter_cap, cell, root.
+struct NoRecorder {
+    static constexpr bool kOn = false;
+};
+
+template <typename T, class Finder, class Corners = OctreeCornerSource, class Recorder = NoRecorder>
+class OctreeTracer {
     static constexpr bool kOwnCorners = std::is_same_v<Corners, OctreeCornerSource>;
 
 public:
     OctreeTracer(const Octree<T>& tree, const Placement& placement, const double* isovalues, int iso_count,
-                 const Finder& finder, const Corners& corners = Corners{})
-        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), finder_(finder), corners_(corners) {
+                 const Finder& finder, const Corners& corners = Corners{}, const Recorder& recorder = Recorder{})
+        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), finder_(finder), corners_(corners),
+          recorder_(recorder) {
         OCTISO_CHECK(tree.dmax() >= 2 && tree.dmax() < kMaxDepth, "dmax ", tree.dmax());
     }
 
@@ -53,11 +64,16 @@ public:
     TraceHit trace(const Ray& ray_world, bool want_normal) const {
         Walk w;
         const BoxClip clip = w.start(scene_, ray_world, want_normal);
+        if constexpr (Recorder::kOn) recorder_.clip(clip.t_in, clip.t_out);
         if (!clip.empty()) node(w, 0, 0, Coord{}, clip.t_in, clip.t_out);
         return w.hit;
     }
 
 private:
+    static Coord child_origin_of(const Coord& o, int c, uint32_t half) {
+        return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
+    }
+
     struct Walk : RayState {
         uint32_t trace[kMaxDepth];   ///< parent trace: node index at each depth down to the current one
     };
@@ -82,6 +98,7 @@ private:
         w.trace[d] = index;
         const InteriorNode<T>& n = tree_.node(d, index);
         const uint32_t half = tree_.child_bit(d);
+        if constexpr (Recorder::kOn) recorder_.enter_node(d, index, o, 2 * half, t0, t1);
         const uint32_t origin[3] = {o.x, o.y, o.z};
         double tm[3];
         int c = 0;
@@ -101,6 +118,10 @@ private:
             double t_next = t1;
             if (i < 3 && tm[order[i]] > t0 && tm[order[i]] < t1) t_next = tm[order[i]];
             else if (i < 3) continue;   // this axis is not crossed inside [t0, t1)
+            if constexpr (Recorder::kOn)
+                if (t_next > t_cur && !n.may_contain_any(c, scene_.isovalues, scene_.iso_count))
+                    recorder_.cull(d, c, child_origin_of(o, c, half), half, double(n.min[c]), double(n.max[c]), t_cur,
+                                   t_next);
             if (t_next > t_cur && n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) {
                 const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
                 bool hit;
@@ -118,6 +139,7 @@ private:
 
     bool cap(Walk& w, uint32_t cap_index, const Coord& co, double t0, double t1) const {
         OCTISO_DCHECK(cap_index < tree_.cap_count(), "cap ", cap_index, " of ", tree_.cap_count());
+        if constexpr (Recorder::kOn) recorder_.enter_cap(tree_.dmax() - 1, cap_index, co, t0, t1);
         w.trace[tree_.dmax() - 1] = cap_index;
         const Cap<T>& cap = tree_.cap(cap_index);
         // The forward neighbour blocks (2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), r = 1..7) are each a
@@ -166,6 +188,7 @@ private:
         };
         bool iso_equals_value = false;
         for (int i = 0; i < scene_.iso_count; ++i) iso_equals_value |= scene_.isovalues[i] == v;
+        if constexpr (Recorder::kOn) recorder_.scalar_leaf(holder_depth, co, side, v, t0, t1, iso_equals_value);
         if (iso_equals_value) return walk_cells(w, co, side, t0, t1, gather);
 
         // Skip the inner cells [co, co + side - 1)^3: constant, never crossed by another iso.
@@ -212,6 +235,14 @@ private:
     }
 
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
+        if constexpr (Recorder::kOn) {
+            double lo = corner[0], hi = corner[0];
+            for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
+            recorder_.cell(v, t_in, t_out, closed_end, lo, hi);
+            const bool hit = intersect_cell(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
+            if (hit) recorder_.root(w.hit.t, w.hit.iso_index);
+            return hit;
+        }
         return intersect_cell(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
     }
 
@@ -219,6 +250,7 @@ private:
     const CellWalkScene scene_;
     const Finder finder_;
     [[no_unique_address]] const Corners corners_;
+    [[no_unique_address]] const Recorder recorder_;
 };
 
 }  // namespace octiso
