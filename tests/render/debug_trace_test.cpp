@@ -54,14 +54,24 @@ TYPED_TEST(DebugTraceTyped, EveryPixelEndsAtTheFramesDepth) {
     EXPECT_GT(hits, 50);
 }
 
-TEST(DebugTrace, EventsNestInsideTheClipAndTheTextNamesThem) {
-    const auto v = make_field<uint8_t>(Field::Sphere, {40, 40, 40});
-    const auto data = build_octree(v.view(), {});
-    const Placement placement;
+/// A u8 sphere of side n at isovalue 60, seen by the default camera at width x height.
+struct SphereScene {
+    SphereScene(uint32_t n, int width, int height)
+        : volume(make_field<uint8_t>(Field::Sphere, {n, n, n})), data(build_octree(volume.view(), {})),
+          camera(frame_data_box(volume.dims, placement, width, height)) {
+        options.isovalues = {60.0};
+    }
+    PixelTrace trace(int x, int y) const { return trace_pixel(data.view(), placement, camera, options, x, y); }
+    DenseVolume<uint8_t> volume;
+    OctreeData<uint8_t> data;
+    Placement placement;
+    Camera camera;
     RenderOptions options;
-    options.isovalues = {60.0};
-    const Camera camera = frame_data_box(v.dims, placement, 16, 16);
-    const PixelTrace trace = trace_pixel(data.view(), placement, camera, options, 8, 8);
+};
+
+TEST(DebugTrace, EventsNestInsideTheClipAndTheTextNamesThem) {
+    const SphereScene scene(40, 16, 16);
+    const PixelTrace trace = scene.trace(8, 8);
     ASSERT_GE(trace.iso_index, 0) << "the centre pixel sees the sphere";
     const PixelTraceEvent& clip = trace.events.front();
     int nodes = 0, cells = 0;
@@ -73,7 +83,7 @@ TEST(DebugTrace, EventsNestInsideTheClipAndTheTextNamesThem) {
         EXPECT_LE(e.t1, clip.t1);
         EXPECT_LE(e.t0, e.t1);
         if (e.kind == Kind::node) {
-            EXPECT_LT(e.depth, data.dmax - 1);
+            EXPECT_LT(e.depth, scene.data.dmax - 1);
         }
     }
     EXPECT_GE(nodes, 1);
@@ -88,22 +98,17 @@ TEST(DebugTrace, EventsNestInsideTheClipAndTheTextNamesThem) {
 }
 
 TEST(DebugTrace, PixelOutsideTheImageIsRefused) {
-    const auto v = make_field<uint8_t>(Field::Sphere, {12, 12, 12});
-    const auto data = build_octree(v.view(), {});
-    const Placement placement;
-    RenderOptions options;
-    options.isovalues = {60.0};
-    const Camera camera = frame_data_box(v.dims, placement, 16, 8);
+    const SphereScene scene(12, 16, 8);
     for (const auto& [x, y] : {std::pair{16, 0}, std::pair{0, 8}, std::pair{-1, 3}, std::pair{3, -1}}) {
         try {
-            (void)trace_pixel(data.view(), placement, camera, options, x, y);
+            (void)scene.trace(x, y);
             ADD_FAILURE() << x << "," << y << " was traced";
         } catch (const Error& e) {
             EXPECT_EQ(e.subject(), "--debug-pixel");
             EXPECT_EQ(e.exit_status(), 2);
         }
     }
-    EXPECT_NO_THROW((void)trace_pixel(data.view(), placement, camera, options, 15, 7));
+    EXPECT_NO_THROW((void)scene.trace(15, 7));
 }
 
 }  // namespace
