@@ -20,6 +20,7 @@
 
 #include "octiso/build.h"
 #include "octiso/camera.h"
+#include "octiso/debug_trace.h"
 #include "octiso/frame.h"
 #include "octiso/oct_file.h"
 #include "octiso/octree.h"
@@ -92,6 +93,10 @@ public:
     /// One frame in one call (make_renderer(options).render(camera)). Throws Error on bad options
     /// or camera.
     Frame render(const Camera& camera, const RenderOptions& options) const;
+
+    /// The path of the primary ray of pixel (x, y) through this octree (octiso-render --debug-pixel);
+    /// debug_trace.h. Throws Error("--debug-pixel", ...) for a pixel outside the image.
+    PixelTrace trace_pixel(const Camera& camera, const RenderOptions& options, int x, int y) const;
 
     /// The dense x-fastest array back (decode_to_dense), dense_bytes() bytes in the byte order
     /// `order`. Throws Error unless out.size() == dense_bytes(); `out` needs no alignment.

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "octiso/debug_trace.h"
 #include "octiso/decode.h"
 #include "octiso/error.h"
 #include "octiso/reader.h"
@@ -26,6 +27,7 @@ struct AnyOctree::Impl {
     virtual void append_to(OctWriter& writer) const = 0;
     virtual Renderer make_renderer(const RenderOptions& options, const RenderLimits& limits) const = 0;
     virtual void decode(std::byte* out, bool swap_bytes) const = 0;
+    virtual PixelTrace trace_pixel(const Camera& camera, const RenderOptions& options, int x, int y) const = 0;
     virtual const void* typed_view() const = 0;   // the Octree<T> for as<T>()
 
     Placement placement;
@@ -88,6 +90,9 @@ public:
         if (!aligned) std::memcpy(out, buffer.data(), size_t(n) * sizeof(T));
     }
 
+    PixelTrace trace_pixel(const Camera& camera, const RenderOptions& options, int x, int y) const override {
+        return octiso::trace_pixel(tree_, placement, camera, options, x, y);
+    }
     const void* typed_view() const override { return &tree_; }
 
 private:
@@ -195,6 +200,10 @@ Renderer AnyOctree::make_renderer(const RenderOptions& options) const {
     Renderer renderer = impl_->make_renderer(options, render_limits());
     renderer.keep_alive(impl_);   // the tree's arrays (or the file's mapping) live in *impl_
     return renderer;
+}
+
+PixelTrace AnyOctree::trace_pixel(const Camera& camera, const RenderOptions& options, int x, int y) const {
+    return impl_->trace_pixel(camera, options, x, y);
 }
 
 Frame AnyOctree::render(const Camera& camera, const RenderOptions& options) const {

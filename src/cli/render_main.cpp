@@ -11,6 +11,7 @@
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
 #include "octiso/any_octree.h"
+#include "octiso/debug_trace.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
 #include "octiso/oct_file.h"
@@ -22,7 +23,8 @@ namespace {
 const char* kUsage =
     "usage: octiso-render FILE.oct --iso V[,V...] -o OUT.png [--eye X,Y,Z --look X,Y,Z --up X,Y,Z --fov DEG]\n"
     "                     [--size WxH] [--steps A:B] [--depth DEPTH.exr] [--normal NORMAL.exr] [--threads N]\n"
-    "                     [--root-finder neubauer|schwarze|linear|exact] [--iterations N] [--no-embree] [--json]";
+    "                     [--root-finder neubauer|schwarze|linear|exact] [--iterations N] [--no-embree] [--json]\n"
+    "       octiso-render FILE.oct --iso V[,V...] --debug-pixel X,Y [camera flags]   (prints that pixel's path)";
 
 /// One line of progress with an ETA, redrawn in place; only when stderr is a terminal.
 class Progress {
@@ -57,11 +59,12 @@ int run(std::vector<std::string>& argv) {
     const auto normal_path = args.value("--normal"), threads = args.value("--threads");
     const auto root_finder = args.value("--root-finder"), iterations = args.value("--iterations");
     const bool no_embree = args.flag("--no-embree"), json = args.flag("--json");
+    const auto debug_pixel = args.value("--debug-pixel");
     const std::vector<std::string> inputs = args.positional();
     args.finish();
     if (inputs.size() != 1) throw Error("octiso-render", std::string("expected exactly one FILE.oct\n") + kUsage);
     if (!iso_text) throw Error("--iso", "is required (one or more isovalues, e.g. --iso 40,120)");
-    if (!out_path && !depth_path && !normal_path) throw Error("-o", "is required (or at least --depth or --normal)");
+    if (!out_path && !depth_path && !normal_path && !debug_pixel) throw Error("-o", "is required (or at least --depth or --normal)");
 
     RenderOptions options;
     options.isovalues = cli::parse_list(*iso_text, "--iso");
@@ -105,6 +108,16 @@ int run(std::vector<std::string>& argv) {
         if (look) camera.look = cli::parse_vec3(*look, "--look");
         if (up) camera.up = cli::parse_vec3(*up, "--up");
         if (fov) camera.fov_deg = cli::parse_double(*fov, "--fov");
+    }
+
+    // --debug-pixel X,Y: re-trace that one pixel (of the first step) and print its path; no image.
+    if (debug_pixel) {
+        const size_t comma = debug_pixel->find(',');
+        if (comma == std::string::npos) throw Error("--debug-pixel", "expected X,Y, found '" + *debug_pixel + "'");
+        const int x = int(cli::parse_int(debug_pixel->substr(0, comma), "--debug-pixel", INT32_MIN, INT32_MAX));
+        const int y = int(cli::parse_int(debug_pixel->substr(comma + 1), "--debug-pixel", INT32_MIN, INT32_MAX));
+        std::cout << AnyOctree::step(file, uint32_t(first)).trace_pixel(camera, options, x, y).text();
+        return 0;
     }
 
     cli::JsonWriter j(std::cout);

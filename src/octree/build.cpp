@@ -31,6 +31,7 @@
 #include "octiso/error.h"
 #include "octree/prepare.h"
 #include "octree/summary.h"
+#include "util/check.h"
 
 namespace octiso {
 
@@ -119,21 +120,9 @@ public:
 
     /// A node at depth dmax-2: 4^3 voxels in 8 blocks of 2^3, each a scalar leaf or a cap.
     Summary<T> build_cap_parent(Coord o, Sink<T>& sink) const {
-        // 1. Load the 5^3 neighbourhood from o, coordinates clamped into the data. Clamped
-        //    positions replicate the border: they fill padding slots of caps and are never
-        //    counted in a range, because the extents below stop at the data.
+        // 1. The 5^3 neighbourhood from o, clamped into the data (summary.h).
         T L[5][5][5];
-        uint32_t xs[5], ys[5], zs[5];
-        for (uint32_t i = 0; i < 5; ++i) {
-            xs[i] = std::min(o.x + i, dims_.x - 1);
-            ys[i] = std::min(o.y + i, dims_.y - 1);
-            zs[i] = std::min(o.z + i, dims_.z - 1);
-        }
-        for (int z = 0; z < 5; ++z)
-            for (int y = 0; y < 5; ++y) {
-                const uint64_t row = v_.index(0, ys[y], zs[z]);
-                for (int x = 0; x < 5; ++x) L[z][y][x] = v_.load(row + xs[x]);
-            }
+        detail::load_neighbourhood(o, dims_, [this](uint32_t x, uint32_t y, uint32_t z) { return v_.at(x, y, z); }, L);
 
         // 2. Each block: a scalar leaf or a cap (summary.h).
         Summary<T> ch[8];
@@ -209,6 +198,9 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
         return builder.combine(d, ch, start, top);
     };
     if (k > 0) descend(descend, 0, Coord{});
+    // The top must consume every piece in the order they were cut, or child_start at depth k-1
+    // would point at another piece's root.
+    OCTISO_CHECK(k == 0 || next_piece == origins.size(), next_piece, " of ", origins.size(), " pieces consumed");
 
     // 3. Concatenate depth by depth. Depths below k come from `top` alone. Freed piece memory is
     //    handed back every few pieces, so peak memory stays near input + output.
@@ -223,6 +215,11 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
         else for (auto& s : sinks) parts.push_back(&s);
         uint64_t total = 0;
         for (auto* p : parts) total += p->nodes[size_t(d)].size();
+        // Children at depth d+1, as they will be concatenated (before this depth's moves free them).
+        uint64_t next_total = 0;
+        if (d + 1 == dmax - 1) for (auto& s : sinks) next_total += s.caps.size();
+        else if (d + 1 < k) next_total = top.nodes[size_t(d + 1)].size();
+        else for (auto& s : sinks) next_total += s.nodes[size_t(d + 1)].size();
         out.nodes[size_t(d)] = UninitArray<InteriorNode<T>>::make(total);
         uint64_t at = 0, child_offset = 0;
         for (auto* p : parts) {
@@ -234,8 +231,14 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
                         throw Error(options.source_name, "octree too large: more than 2^32 nodes at depth " +
                                                              std::to_string(d + 1) + " (32-bit child indices)");
                     n.child_start = uint32_t(global);
+                    OCTISO_CHECK(global + uint64_t(std::popcount(unsigned(n.child_mask))) <= next_total,
+                                 "depth ", d, ": children from ", global, " past ", next_total, " at depth ", d + 1);
                 }
                 child_offset += d + 1 == dmax - 1 ? p->caps.size() : p->nodes[size_t(d + 1)].size();
+            } else {
+                for (const auto& n : v)
+                    OCTISO_CHECK(uint64_t(n.child_start) + uint64_t(std::popcount(unsigned(n.child_mask))) <= next_total,
+                                 "depth ", d, ": children from ", n.child_start, " past ", next_total, " at depth ", d + 1);
             }
             out.stats.scalar_leaves_per_depth[size_t(d)] += p->leaves[size_t(d)];
             move_into(out.nodes[size_t(d)], at, v);

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "octiso/error.h"
+#include "util/check.h"
 
 namespace octiso {
 
@@ -93,6 +94,14 @@ public:
 
     OctreeData<T> run() {
         build(0, Coord{});
+        // Every stored node's children must lie in the next depth's array (the loader would refuse
+        // the file; an in-memory octree would be traversed out of bounds).
+        for (int d = 0; d <= dmax_ - 2; ++d) {
+            const uint64_t next = d + 1 == dmax_ - 1 ? caps_.size() : nodes_[size_t(d + 1)].size();
+            for (const InteriorNode<T>& n : nodes_[size_t(d)])
+                OCTISO_CHECK(uint64_t(n.child_start) + uint64_t(std::popcount(unsigned(n.child_mask))) <= next,
+                             "depth ", d, ": children from ", n.child_start, " past ", next, " at depth ", d + 1);
+        }
         OctreeData<T> out;
         out.dims = dims_;
         out.dmax = dmax_;
@@ -202,15 +211,7 @@ private:
 
     Summary<T> build_cap_parent(Coord o) {
         T L[5][5][5];
-        uint32_t xs[5], ys[5], zs[5];
-        for (uint32_t i = 0; i < 5; ++i) {
-            xs[i] = std::min(o.x + i, dims_.x - 1);
-            ys[i] = std::min(o.y + i, dims_.y - 1);
-            zs[i] = std::min(o.z + i, dims_.z - 1);
-        }
-        for (int z = 0; z < 5; ++z)
-            for (int y = 0; y < 5; ++y)
-                for (int x = 0; x < 5; ++x) L[z][y][x] = f_.value<T>(xs[x], ys[y], zs[z]);
+        detail::load_neighbourhood(o, dims_, [this](uint32_t x, uint32_t y, uint32_t z) { return f_.value<T>(x, y, z); }, L);
         Summary<T> ch[8];
         const uint64_t start = caps_.size();
         detail::cap_parent_children(

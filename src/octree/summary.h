@@ -1,7 +1,8 @@
 // The bottom-up rules both octree builders share (build.cpp from a dense array, sparse_synthetic.cpp
 // from an analytic field): what a finished subtree tells its parent (Summary), how 8 children fold
 // into a scalar leaf or a stored InteriorNode, and how a depth dmax-2 node's 8 blocks of 2^3 become
-// leaves or caps from its 5^3 voxel neighbourhood (Knoll et al. 2006, Sec. 3.3, 4.1).
+// leaves or caps from its 5^3 voxel neighbourhood, loaded by the one clamped load both use
+// (Knoll et al. 2006, Sec. 3.3, 4.1).
 #pragma once
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <limits>
 
 #include "octiso/octree.h"
+#include "util/check.h"
 
 namespace octiso::detail {
 
@@ -76,6 +78,23 @@ bool fold_children(int d, const Summary<T>* ch, uint64_t start, const Mergeable&
     node.child_start = uint32_t(start);   // local; the caller offsets and range-checks it
     out = {any_data ? midpoint(lo, hi) : T{}, cmin, cmax, lo, hi, false, !any_data};
     return false;
+}
+
+/// The 5^3 voxel neighbourhood L[z][y][x] = voxel(o + (x, y, z)) of a node at depth dmax-2 with
+/// origin o (inside the data), coordinates clamped into the data: clamped slots replicate the
+/// border. They fill padding slots of caps and never enter a range, because the extents of
+/// cap_parent_children stop at the data. `voxel(x, y, z) -> T` reads one data voxel.
+template <typename T, class Voxel> void load_neighbourhood(Coord o, Dims dims, const Voxel& voxel, T (&L)[5][5][5]) {
+    OCTISO_DCHECK(o.x < dims.x && o.y < dims.y && o.z < dims.z, "cap parent (", o.x, ",", o.y, ",", o.z, ") outside the data");
+    uint32_t xs[5], ys[5], zs[5];
+    for (uint32_t i = 0; i < 5; ++i) {
+        xs[i] = std::min(o.x + i, dims.x - 1);
+        ys[i] = std::min(o.y + i, dims.y - 1);
+        zs[i] = std::min(o.z + i, dims.z - 1);
+    }
+    for (int z = 0; z < 5; ++z)
+        for (int y = 0; y < 5; ++y)
+            for (int x = 0; x < 5; ++x) L[z][y][x] = voxel(xs[x], ys[y], zs[z]);
 }
 
 /// The 8 children of a node at depth dmax-2 with origin o, from its 5^3 voxel neighbourhood L[z][y][x]

@@ -16,6 +16,7 @@
 #include "octiso/limits.h"
 #include "octiso/volume.h"
 #include "math/ray.h"
+#include "render/cell_dda.h"
 #include "render/roots.h"
 #include "render/traverse.h"
 
@@ -153,59 +154,29 @@ private:
 
     /// DDA over the level-l units [lo, hi) (per axis, hi exclusive) the ray crosses on [t0, t1),
     /// in order; a macrocell is entered when an isovalue lies in its range, a cell is solved.
-    /// Unit m of level l spans the index planes [m u, (m+1) u], u = B^l.
+    /// Unit m of level l spans the index planes [m u, (m+1) u], u = B^l (the one cell DDA,
+    /// cell_dda.h; a ray lying in the data's top face takes the last unit of the level).
     bool walk(Walk& w, int l, const int64_t lo[3], const int64_t hi[3], double t0, double t1) const {
-        const IndexRay& r = w.ray;
-        const double u = unit_[size_t(l)];
-        int64_t cell[3];
-        for (int a = 0; a < 3; ++a) {
-            const double p = r.origin[a] + t0 * r.dir[a];
-            int64_t i = int64_t(std::floor(p / u));
-            const int64_t b0 = lo[a], b1 = hi[a] - 1;
-            i = std::clamp(i, b0, b1);
-            // Settle rounding at a face with the same plane times the DDA steps on (as traverse.h).
-            if (r.dir[a] > 0) {
-                if (i < b1 && r.plane_t(a, double(i + 1) * u) <= t0) ++i;
-                else if (i > b0 && r.plane_t(a, double(i) * u) > t0) --i;
-            } else if (r.dir[a] < 0) {
-                if (i > b0 && r.plane_t(a, double(i) * u) <= t0) --i;
-                else if (i < b1 && r.plane_t(a, double(i + 1) * u) > t0) ++i;
-            }
-            cell[a] = i;
-        }
-        double t_cur = t0;
-        double corner[8];
-        for (;;) {
-            double t_face[3];
-            for (int a = 0; a < 3; ++a)
-                t_face[a] = r.dir[a] > 0 ? r.plane_t(a, double(cell[a] + 1) * u)
-                          : r.dir[a] < 0 ? r.plane_t(a, double(cell[a]) * u)
-                                         : std::numeric_limits<double>::infinity();
-            int axis = 0;
-            if (t_face[1] < t_face[axis]) axis = 1;
-            if (t_face[2] < t_face[axis]) axis = 2;
-            const double t_out = std::min(t_face[axis], t1);
-            const bool closed_end = t_out == w.t_exit;
-            if (t_out > t_cur || closed_end) {
-                if (l == 0) {
-                    const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
-                    corners_.gather(v, corner);
-                    if (test_cell(w, v, corner, t_cur, t_out, closed_end)) return true;
-                } else if (scene_.any_iso_in(double(grid_.min_at(l, cell[0], cell[1], cell[2])),
-                                      double(grid_.max_at(l, cell[0], cell[1], cell[2])))) {
-                    const int64_t b = grid_.branching();
-                    const auto& below = grid_.count(l - 1);
-                    const int64_t clo[3] = {cell[0] * b, cell[1] * b, cell[2] * b};
-                    const int64_t chi[3] = {std::min(clo[0] + b, below[0]), std::min(clo[1] + b, below[1]),
-                                            std::min(clo[2] + b, below[2])};
-                    if (walk(w, l - 1, clo, chi, t_cur, t_out)) return true;
-                }
-            }
-            if (t_face[axis] >= t1) return false;
-            t_cur = std::max(t_cur, t_face[axis]);
-            cell[axis] += r.dir[axis] > 0 ? 1 : -1;
-            if (cell[axis] < lo[axis] || cell[axis] >= hi[axis]) return false;
-        }
+        const auto& top = grid_.count(l);
+        const DdaBox box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}, {top[0] - 1, top[1] - 1, top[2] - 1}, scene_.box_hi};
+        return walk_units(w.ray, ScaledCells{unit_[size_t(l)]}, box, t0, t1, w.t_exit,
+                          [&](const int64_t cell[3], double t_in, double t_out, bool closed_end) {
+                              if (l == 0) {
+                                  const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
+                                  double corner[8];
+                                  corners_.gather(v, corner);
+                                  return test_cell(w, v, corner, t_in, t_out, closed_end);
+                              }
+                              if (!scene_.any_iso_in(double(grid_.min_at(l, cell[0], cell[1], cell[2])),
+                                                     double(grid_.max_at(l, cell[0], cell[1], cell[2]))))
+                                  return false;
+                              const int64_t b = grid_.branching();
+                              const auto& below = grid_.count(l - 1);
+                              const int64_t clo[3] = {cell[0] * b, cell[1] * b, cell[2] * b};
+                              const int64_t chi[3] = {std::min(clo[0] + b, below[0]), std::min(clo[1] + b, below[1]),
+                                                      std::min(clo[2] + b, below[2])};
+                              return walk(w, l - 1, clo, chi, t_in, t_out);
+                          });
     }
 
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {

@@ -14,6 +14,7 @@
 #include "math/ray.h"
 #include "octiso/limits.h"
 #include "render/roots.h"
+#include "util/check.h"
 
 namespace octiso {
 
@@ -37,6 +38,8 @@ struct CellWalkScene {
     bool has_cells = false;   ///< false when an extent is 1: no cell exists, nothing is ever hit
 
     CellWalkScene(Dims dims, const Placement& p, const double* isos, int count) : iso_count(count), placement(p) {
+        // The fixed isovalue array is what every per-cell loop runs over; more would overrun it.
+        OCTISO_CHECK(count >= 0 && count <= kMaxIsovalues, count, " isovalues, at most ", kMaxIsovalues);
         for (int i = 0; i < count; ++i) isovalues[i] = isos[i];
         box_hi = {double(dims.x) - 1, double(dims.y) - 1, double(dims.z) - 1};
         has_cells = dims.x >= 2 && dims.y >= 2 && dims.z >= 2;
@@ -73,6 +76,9 @@ struct RayState {
 template <class Finder>
 inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
                            const double corner[8], double t_in, double t_out, bool closed_end) {
+    OCTISO_DCHECK(double(v.x) + 1 <= scene.box_hi[0] && double(v.y) + 1 <= scene.box_hi[1] &&
+                      double(v.z) + 1 <= scene.box_hi[2],
+                  "cell (", v.x, ",", v.y, ",", v.z, ") outside the data box");
     double lo = corner[0], hi = corner[0];
     for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
     if (!scene.any_iso_in(lo, hi)) return false;   // a NaN corner fails every comparison

@@ -15,6 +15,7 @@
 
 #include "octiso/frame.h"
 #include "octiso/tiles.h"
+#include "util/check.h"
 
 namespace octiso {
 
@@ -33,7 +34,9 @@ template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<
         [&](const tbb::blocked_range<int>& range) {
             for (int i = range.begin(); i < range.end(); ++i) {
                 TileCounters local;
-                body(grid.rect(all ? i : tiles[size_t(i)]), local);
+                const int tile = all ? i : tiles[size_t(i)];
+                OCTISO_DCHECK(tile >= 0 && tile < grid.count(), "tile ", tile, " of ", grid.count());
+                body(grid.rect(tile), local);
                 rays += local.rays;
                 hits += local.hits;
             }

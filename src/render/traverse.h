@@ -16,6 +16,8 @@
 // (measured by `octiso-bench grid`: +3-5 % frames/s on octree data, BENCHMARKS.md, grid section).
 // The corner source is a policy only for the grid benchmark's "octree over array data" variant
 // (Knoll 2006 Table 3); with the default, OctreeCornerSource, the policy costs nothing.
+// The recorder is a policy only for `--debug-pixel` (octiso/debug_trace.h): with the default,
+// NoRecorder, every recording call sits behind `if constexpr (Recorder::kOn)` and is not compiled.
 #pragma once
 
 #include <algorithm>
@@ -25,9 +27,11 @@
 
 #include "octiso/octree.h"
 #include "render/cell.h"
+#include "render/cell_dda.h"
 #include "render/cell_hit.h"
 #include "math/ray.h"
 #include "render/roots.h"
+#include "util/check.h"
 
 namespace octiso {
 
@@ -36,24 +40,40 @@ namespace octiso {
 /// corner read (e.g. ArrayCorners<T> in src/reference/macrocell.h); the octree then only culls.
 struct OctreeCornerSource {};
 
-template <typename T, class Finder, class Corners = OctreeCornerSource> class OctreeTracer {
+/// The default recorder: records nothing. A recording type sets kOn = true and provides the
+/// const calls of PixelTraceRecorder (src/render/debug_trace.cpp): clip, enter_node, cull,
+/// scalar_leaf, enter_cap, cell, root.
+struct NoRecorder {
+    static constexpr bool kOn = false;
+};
+
+template <typename T, class Finder, class Corners = OctreeCornerSource, class Recorder = NoRecorder>
+class OctreeTracer {
     static constexpr bool kOwnCorners = std::is_same_v<Corners, OctreeCornerSource>;
 
 public:
     OctreeTracer(const Octree<T>& tree, const Placement& placement, const double* isovalues, int iso_count,
-                 const Finder& finder, const Corners& corners = Corners{})
-        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), finder_(finder), corners_(corners) {}
+                 const Finder& finder, const Corners& corners = Corners{}, const Recorder& recorder = Recorder{})
+        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), finder_(finder), corners_(corners),
+          recorder_(recorder) {
+        OCTISO_CHECK(tree.dmax() >= 2 && tree.dmax() < kMaxDepth, "dmax ", tree.dmax());
+    }
 
     /// First hit along the world ray; the normal is computed only if `want_normal`.
     /// Thread-safe: all per-ray state lives on the caller's stack.
     TraceHit trace(const Ray& ray_world, bool want_normal) const {
         Walk w;
         const BoxClip clip = w.start(scene_, ray_world, want_normal);
+        if constexpr (Recorder::kOn) recorder_.clip(clip.t_in, clip.t_out);
         if (!clip.empty()) node(w, 0, 0, Coord{}, clip.t_in, clip.t_out);
         return w.hit;
     }
 
 private:
+    static Coord child_origin_of(const Coord& o, int c, uint32_t half) {
+        return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
+    }
+
     struct Walk : RayState {
         uint32_t trace[kMaxDepth];   ///< parent trace: node index at each depth down to the current one
     };
@@ -73,9 +93,12 @@ private:
     // and reloaded as a 64-bit register pair, a store-forwarding stall that cost 18 % of node()
     // (perf annotate, plume 256^3 at 1024^2).
     bool node(Walk& w, int d, uint32_t index, const Coord& o, double t0, double t1) const {
+        OCTISO_DCHECK(d >= 0 && d <= tree_.dmax() - 2, "interior depth ", d, ", dmax ", tree_.dmax());
+        OCTISO_DCHECK(index < tree_.node_count(d), "node ", index, " of ", tree_.node_count(d), " at depth ", d);
         w.trace[d] = index;
         const InteriorNode<T>& n = tree_.node(d, index);
         const uint32_t half = tree_.child_bit(d);
+        if constexpr (Recorder::kOn) recorder_.enter_node(d, index, o, 2 * half, t0, t1);
         const uint32_t origin[3] = {o.x, o.y, o.z};
         double tm[3];
         int c = 0;
@@ -95,6 +118,10 @@ private:
             double t_next = t1;
             if (i < 3 && tm[order[i]] > t0 && tm[order[i]] < t1) t_next = tm[order[i]];
             else if (i < 3) continue;   // this axis is not crossed inside [t0, t1)
+            if constexpr (Recorder::kOn)
+                if (t_next > t_cur && !n.may_contain_any(c, scene_.isovalues, scene_.iso_count))
+                    recorder_.cull(d, c, child_origin_of(o, c, half), half, double(n.min[c]), double(n.max[c]), t_cur,
+                                   t_next);
             if (t_next > t_cur && n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) {
                 const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
                 bool hit;
@@ -111,6 +138,8 @@ private:
     }
 
     bool cap(Walk& w, uint32_t cap_index, const Coord& co, double t0, double t1) const {
+        OCTISO_DCHECK(cap_index < tree_.cap_count(), "cap ", cap_index, " of ", tree_.cap_count());
+        if constexpr (Recorder::kOn) recorder_.enter_cap(tree_.dmax() - 1, cap_index, co, t0, t1);
         w.trace[tree_.dmax() - 1] = cap_index;
         const Cap<T>& cap = tree_.cap(cap_index);
         // The forward neighbour blocks (2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), r = 1..7) are each a
@@ -159,6 +188,7 @@ private:
         };
         bool iso_equals_value = false;
         for (int i = 0; i < scene_.iso_count; ++i) iso_equals_value |= scene_.isovalues[i] == v;
+        if constexpr (Recorder::kOn) recorder_.scalar_leaf(holder_depth, co, side, v, t0, t1, iso_equals_value);
         if (iso_equals_value) return walk_cells(w, co, side, t0, t1, gather);
 
         // Skip the inner cells [co, co + side - 1)^3: constant, never crossed by another iso.
@@ -180,59 +210,39 @@ private:
         return ti1 < t1 && walk_cells(w, co, side, ti1, t1, gather);
     }
 
-    /// DDA over the cells of the box [lo, lo + side)^3 that the ray crosses on [t0, t1), in order.
-    /// Each data cell gets the half-open piece [t_in, t_out) (closed at the data exit); `gather`
-    /// fills its 8 corners. Returns true at the first hit.
+    /// The cells of the box [lo, lo + side)^3 that the ray crosses on [t0, t1), in order, by the
+    /// one cell DDA (cell_dda.h). Each data cell gets the half-open piece [t_in, t_out) (closed at
+    /// the data exit); `gather` fills its 8 corners. Cells of the box beyond the data (padding)
+    /// are stepped over. Returns true at the first hit.
     template <class Gather>
     bool walk_cells(Walk& w, const Coord& lo, uint32_t side, double t0, double t1, Gather&& gather) const {
-        const IndexRay& r = w.ray;
-        const uint32_t box_lo[3] = {lo.x, lo.y, lo.z};
         const Dims dims = tree_.dims();
-        const uint32_t last_cell[3] = {dims.x - 2, dims.y - 2, dims.z - 2};
-        int64_t cell[3];
-        for (int a = 0; a < 3; ++a) {
-            const double p = r.origin[a] + t0 * r.dir[a];
-            int64_t i = int64_t(std::floor(p));
-            if (r.dir[a] == 0 && p == scene_.box_hi[a]) i = int64_t(last_cell[a]);   // lying in the top face
-            const int64_t b0 = box_lo[a], b1 = int64_t(box_lo[a]) + side - 1;
-            i = std::clamp(i, b0, b1);
-            // Settle rounding of p at a cell face with the same plane times the DDA steps on.
-            if (r.dir[a] > 0) {
-                if (i < b1 && r.plane_t(a, double(i + 1)) <= t0) ++i;
-                else if (i > b0 && r.plane_t(a, double(i)) > t0) --i;
-            } else if (r.dir[a] < 0) {   // cell i holds [plane_t(i+1), plane_t(i))
-                if (i > b0 && r.plane_t(a, double(i)) <= t0) --i;
-                else if (i < b1 && r.plane_t(a, double(i + 1)) > t0) ++i;
-            }
-            cell[a] = i;
-        }
-        double t_cur = t0;
-        double corner[8];
-        for (;;) {
-            double t_face[3];
-            for (int a = 0; a < 3; ++a)
-                t_face[a] = r.dir[a] > 0 ? r.plane_t(a, double(cell[a] + 1))
-                          : r.dir[a] < 0 ? r.plane_t(a, double(cell[a]))
-                                         : std::numeric_limits<double>::infinity();
-            int axis = 0;
-            if (t_face[1] < t_face[axis]) axis = 1;
-            if (t_face[2] < t_face[axis]) axis = 2;
-            const double t_out = std::min(t_face[axis], t1);
-            const bool in_data = cell[0] <= last_cell[0] && cell[1] <= last_cell[1] && cell[2] <= last_cell[2];
-            const bool closed_end = t_out == w.t_exit;
-            if (in_data && (t_out > t_cur || closed_end)) {
-                const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
-                gather(v, corner);
-                if (test_cell(w, v, corner, t_cur, t_out, closed_end)) return true;
-            }
-            if (t_face[axis] >= t1) return false;
-            t_cur = std::max(t_cur, t_face[axis]);
-            cell[axis] += r.dir[axis] > 0 ? 1 : -1;
-            if (cell[axis] < int64_t(box_lo[axis]) || cell[axis] >= int64_t(box_lo[axis]) + side) return false;
-        }
+        const int64_t last_cell[3] = {int64_t(dims.x) - 2, int64_t(dims.y) - 2, int64_t(dims.z) - 2};
+        const DdaBox box{{lo.x, lo.y, lo.z},
+                         {int64_t(lo.x) + side, int64_t(lo.y) + side, int64_t(lo.z) + side},
+                         {last_cell[0], last_cell[1], last_cell[2]},
+                         scene_.box_hi};
+        return walk_units(w.ray, UnitCells{}, box, t0, t1, w.t_exit,
+                          [&](const int64_t cell[3], double t_in, double t_out, bool closed_end) {
+                              if (cell[0] > last_cell[0] || cell[1] > last_cell[1] || cell[2] > last_cell[2])
+                                  return false;
+                              OCTISO_DCHECK(cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0, "cell below the data box");
+                              const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
+                              double corner[8];
+                              gather(v, corner);
+                              return test_cell(w, v, corner, t_in, t_out, closed_end);
+                          });
     }
 
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
+        if constexpr (Recorder::kOn) {
+            double lo = corner[0], hi = corner[0];
+            for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
+            recorder_.cell(v, t_in, t_out, closed_end, lo, hi);
+            const bool hit = intersect_cell(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
+            if (hit) recorder_.root(w.hit.t, w.hit.iso_index);
+            return hit;
+        }
         return intersect_cell(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
     }
 
@@ -240,6 +250,7 @@ private:
     const CellWalkScene scene_;
     const Finder finder_;
     [[no_unique_address]] const Corners corners_;
+    [[no_unique_address]] const Recorder recorder_;
 };
 
 }  // namespace octiso
