@@ -8,7 +8,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${OCTISO_ASAN_BUILD_DIR:-$root/build-asan}
 jobs=${OCTISO_JOBS:-$(nproc)}
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOCTISO_SANITIZE=ON -DOCTISO_BUILD_BENCH=OFF >/dev/null
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOCTISO_SANITIZE=ON -DOCTISO_BUILD_BENCH=OFF -DOCTISO_BUILD_PYTHON=OFF ${OCTISO_CMAKE_ARGS:-} >/dev/null
 cmake --build "$build" -j "$jobs"
 cd "$build"
 # halt_on_error: a report fails the test instead of scrolling past; leaks are real bugs here too.
