@@ -15,6 +15,7 @@
 #include "octiso/build.h"
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
+#include "octiso/output_guard.h"
 #include "octiso/reader.h"
 #include "octiso/synthetic.h"
 #include "octree/sparse_synthetic.h"
@@ -302,6 +303,11 @@ int convert(std::vector<std::string>& argv) {
     const Source src = parse_source(args, positional);
     args.finish();
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
+    if (!src.synthetic) {   // issue 18: never replace an input (same device and inode)
+        std::vector<std::string> inputs;
+        for (uint32_t i = 0; i < src.count(); ++i) inputs.push_back(src.step_path(i));
+        refuse_output_onto_input(*out, inputs);
+    }
     const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
     // 1. Open every step and compare it with the first before anything is written. For raw

@@ -17,6 +17,7 @@
 #include "octiso/decode.h"
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
+#include "octiso/output_guard.h"
 
 namespace {
 
@@ -50,12 +51,7 @@ void extract_raw(const OctFile& file, Extract& ex) {
         decode_to_dense(tree, data.data());
         if (ex.big_endian)
             for (T& v : data) v = VolumeView<T>::byte_swapped(v);
-        AtomicOutput out(ex.path);
-        std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");
-        if (!f) throw Error(out.temp_path(), std::string("cannot create: ") + std::strerror(errno), ErrorKind::Other);
-        const bool ok = std::fwrite(data.data(), 1, size_t(ex.bytes), f) == size_t(ex.bytes);
-        if (std::fclose(f) != 0 || !ok) throw Error(ex.path, "write failed", ErrorKind::Other);
-        out.commit();
+        write_file_atomically(ex.path, data.data(), ex.bytes);   // every write, fsync and close checked
     });
 }
 
@@ -171,6 +167,7 @@ int main(int argc, char** argv) {
             throw Error("", std::string(files.empty() ? "no input file" : "more than one input file") + "; " + kUsage);
         if ((step_text || endian_text) && !extract_path)
             throw Error(step_text ? "--step" : "--endian", "only makes sense with --extract-raw");
+        if (extract_path) refuse_output_onto_input(*extract_path, files, "--extract-raw");   // issue 18
         Extract ex;
         if (extract_path) {
             ex.path = *extract_path;

@@ -13,6 +13,7 @@
 #include "octiso/error.h"
 #include "octiso/image.h"
 #include "octiso/oct_file.h"
+#include "octiso/output_guard.h"
 #include "octiso/render.h"
 
 namespace octiso {
@@ -89,6 +90,11 @@ int run(std::vector<std::string>& argv) {
     if (out_path) check_image_path(name_for(out_path, "-o", first), "-o");
     if (depth_path) check_image_path(name_for(depth_path, "--depth", first), "--depth");
     if (normal_path) check_image_path(name_for(normal_path, "--normal", first), "--normal");
+    for (long long k = first; k <= last; ++k) {   // issue 18: never replace the input
+        if (out_path) refuse_output_onto_input(name_for(out_path, "-o", k), inputs, "-o");
+        if (depth_path) refuse_output_onto_input(name_for(depth_path, "--depth", k), inputs, "--depth");
+        if (normal_path) refuse_output_onto_input(name_for(normal_path, "--normal", k), inputs, "--normal");
+    }
     const RenderLimits limits{info.iso_range, inputs[0]};
     validate_options(options, limits);
 
