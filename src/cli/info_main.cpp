@@ -51,6 +51,7 @@ void extract_raw(const OctFile& file, Extract& ex) {
         decode_to_dense(tree, data.data());
         if (ex.big_endian)
             for (T& v : data) v = VolumeView<T>::byte_swapped(v);
+        file.check_unchanged();   // issue 18: the decoded data came from what was validated
         write_file_atomically(ex.path, data.data(), ex.bytes);   // every write, fsync and close checked
     });
 }

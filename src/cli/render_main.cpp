@@ -128,6 +128,7 @@ int run(std::vector<std::string>& argv) {
             using T = decltype(tag);
             Renderer(file.step<T>(uint32_t(k)), info.placement, options, limits).render(camera, frame);
         });
+        file.check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
         if (out_path) write_colour_image(name_for(out_path, "-o", k), frame);
         if (depth_path) write_depth_image(name_for(depth_path, "--depth", k), frame);
         if (normal_path) write_normal_image(name_for(normal_path, "--normal", k), frame);

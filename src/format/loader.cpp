@@ -47,6 +47,7 @@ struct OctFile::Impl {
     uint64_t bytes = 0;
     int fd = -1;         // kept open: holds the shared flock, and the fault handler fstats it
     int guard_slot = -1; // io::register_mapping slot (mapping_guard.h)
+    struct stat opened {};   // fstat at open, for check_unchanged()
     OctInfo info;
     const SectionEntry* table = nullptr;   // step_count * dmax entries, (step, depth) order
     std::unique_ptr<StepState[]> steps;
@@ -117,6 +118,7 @@ void OctFile::Impl::map_file() {
     if (!S_ISREG(st.st_mode))
         fail(S_ISDIR(st.st_mode) ? "is a directory, not a .oct file" : "is not a regular file (a FIFO, socket or device)");
     io::lock_shared_or_refuse(fd, path);
+    opened = st;
     bytes = uint64_t(st.st_size);
     if (bytes < sizeof(FileHeader))
         fail("too short to be a .oct file (expected at least " + num(sizeof(FileHeader)) + " bytes, found " + num(bytes) + ")");
@@ -289,6 +291,14 @@ template <typename T> Octree<T> OctFile::step(uint32_t k) const {
 }
 
 StepSizes OctFile::step_sizes(uint32_t k) const { return impl_->ensure_valid(k); }
+
+void OctFile::check_unchanged() const {
+    struct stat st {};
+    const Impl& m = *impl_;
+    if (::fstat(m.fd, &st) != 0 || st.st_size != m.opened.st_size || st.st_mtim.tv_sec != m.opened.st_mtim.tv_sec ||
+        st.st_mtim.tv_nsec != m.opened.st_mtim.tv_nsec)
+        m.fail("the file changed while it was being read (rewritten in place by another program); nothing was written");
+}
 
 #define OCTISO_INSTANTIATE(T) template Octree<T> OctFile::step<T>(uint32_t) const;
 OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)

@@ -61,7 +61,12 @@ LoadedVolume read_raw(const std::string& path, Dims dims, ScalarType type, Endia
     //    clean one-line exit if the file is truncated or rewritten while it is being read.
     io::lock_shared_or_refuse(fd.fd, path);
     void* base = ::mmap(nullptr, size_t(file_bytes), PROT_READ, MAP_PRIVATE, fd.fd, 0);
-    if (base == MAP_FAILED) throw Error(path, std::string("cannot map: ") + std::strerror(errno), ErrorKind::Other);
+    if (base == MAP_FAILED) {
+        if (errno == ENOMEM)   // the declared grid does not fit the address space allowed (ulimit -v)
+            throw Error(path, "out of memory mapping " + std::to_string(file_bytes) + " bytes (" + dims_text(dims) + " " +
+                                  std::string(scalar_type_name(type)) + ")");
+        throw Error(path, std::string("cannot map: ") + std::strerror(errno), ErrorKind::Other);
+    }
     const int kept_fd = ::fcntl(fd.fd, F_DUPFD_CLOEXEC, 0);   // the flock belongs to the open file, shared by the dup
     const int slot = kept_fd >= 0 ? io::register_mapping(base, file_bytes, kept_fd, path) : -1;
     std::shared_ptr<const void> owner(base, [file_bytes, kept_fd, slot](const void* p) {
