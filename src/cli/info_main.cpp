@@ -18,13 +18,14 @@
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
 #include "octiso/output_guard.h"
+#include "octiso/verify.h"
 
 namespace {
 
 using namespace octiso;
 
 constexpr const char* kUsage =
-    "usage: octiso-info FILE.oct [--json] [--extract-raw OUT.raw [--step K] [--endian little|big]]";
+    "usage: octiso-info FILE.oct [--json] [--verify] [--extract-raw OUT.raw [--step K] [--endian little|big]]";
 
 struct Extract {
     std::string path;
@@ -155,6 +156,7 @@ int main(int argc, char** argv) {
         cli::Args args(argv_rest);
         const bool json = args.flag("--json");
         const bool help = args.flag("--help") || args.flag("-h");
+        const bool verify = args.flag("--verify");
         const std::optional<std::string> extract_path = args.value("--extract-raw");
         const std::optional<std::string> step_text = args.value("--step");
         const std::optional<std::string> endian_text = args.value("--endian");
@@ -187,6 +189,11 @@ int main(int argc, char** argv) {
         std::vector<StepSizes> steps;
         steps.reserve(file.info().step_count);
         for (uint32_t k = 0; k < file.info().step_count; ++k) steps.push_back(file.step_sizes(k));
+        if (verify) {   // issue 18: every min/max and scalar recomputed from the leaves; a lie exits 2
+            const VerifyStats v = verify_octree(file);
+            (json ? std::cerr : std::cout) << files[0] << ": verified " << v.nodes << " interior nodes, " << v.ranges
+                                           << " child ranges: every one agrees with the leaves\n";
+        }
         if (extract_path) extract_raw(file, ex);
 
         const Extract* exp = extract_path ? &ex : nullptr;

@@ -14,6 +14,7 @@
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
 #include "octiso/output_guard.h"
+#include "octiso/verify.h"
 
 namespace octiso::test {
 namespace {
@@ -27,6 +28,7 @@ struct HostileFiles : ::testing::Test {
     RunResult render(const std::string& args) { return run_capture("'" + tool("octiso-render") + "' " + args, err); }
     void make_oct(const std::string& name) {
         ASSERT_EQ(convert("--synthetic sphere:12 -o " + q(name)).exit_status, 0);
+        ASSERT_NO_THROW(verify_octree(OctFile::open(dir.file(name))));
     }
 };
 

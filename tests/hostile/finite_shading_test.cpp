@@ -10,6 +10,8 @@
 
 #include "hostile/hostile_util.h"
 #include "octiso/image.h"
+#include "octiso/oct_file.h"
+#include "octiso/verify.h"
 #include "render/roots.h"
 #include "render/shade.h"
 
@@ -77,6 +79,7 @@ TEST(HostileShading, IssueVolumeRendersWithFiniteNormalsAndColours) {
     RunResult r = run_capture("'" + tool("octiso-convert") + "' '" + dir.file("v.raw") + "' --dims 2,2,2 --type f64 -o '" +
                                   dir.file("v.oct") + "'", err);
     ASSERT_EQ(r.exit_status, 0) << r.err;
+    ASSERT_NO_THROW(verify_octree(OctFile::open(dir.file("v.oct"))));
     for (const char* finder : {"neubauer", "schwarze", "linear", "exact"}) {
         SCOPED_TRACE(finder);
         r = run_capture("'" + tool("octiso-render") + "' '" + dir.file("v.oct") + "' --iso 0.5 --size 96x96 --root-finder " +

@@ -14,6 +14,7 @@
 #include "io/atomic_output.h"
 #include "octiso/image.h"
 #include "octiso/oct_file.h"
+#include "octiso/verify.h"
 
 namespace octiso::test {
 namespace {
@@ -82,7 +83,7 @@ TEST_F(HostileKill, SigkillLeavesATemporaryThatTheNextWriteRemoves) {
                                     dir.file("err"));
     ASSERT_EQ(r.exit_status, 0) << r.err;
     EXPECT_TRUE(temporaries(dir.path()).empty()) << "the next write into the folder must clean the dead process's temporary";
-    EXPECT_NO_THROW(OctFile::open(dir.file("next.oct")));
+    EXPECT_NO_THROW(verify_octree(OctFile::open(dir.file("next.oct"))));
     EXPECT_EQ(read_all(out), old_);
 }
 
