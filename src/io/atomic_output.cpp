@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstring>
 #include <mutex>
+#include <set>
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -141,7 +142,13 @@ int remove_stale_temporaries(const std::string& dir) {
 }  // namespace io
 
 AtomicOutput::AtomicOutput(std::string path) : path_(std::move(path)), temp_(temp_name(path_)) {
-    io::remove_stale_temporaries(folder_of(path_));
+    {   // Once per folder and process: a series render writes thousands of frames into one.
+        static std::mutex m;
+        static std::set<std::string> swept;
+        const std::string folder = folder_of(path_);
+        std::lock_guard<std::mutex> lock(m);
+        if (swept.insert(folder).second) io::remove_stale_temporaries(folder);
+    }
     slot_ = register_temporary(temp_);
 }
 
