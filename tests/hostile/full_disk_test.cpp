@@ -5,7 +5,6 @@
 // of a skip when OCTISO_REQUIRE_ALL=1 (CI).
 #include <gtest/gtest.h>
 
-#include <sys/mount.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -16,47 +15,6 @@
 
 namespace octiso::test {
 namespace {
-
-bool required() {
-    const char* v = std::getenv("OCTISO_REQUIRE_ALL");
-    return v && std::string(v) == "1";
-}
-
-class SmallTmpfs {
-public:
-    explicit SmallTmpfs(const std::string& where) : where_(where) {
-        std::filesystem::create_directories(where_);
-        if (::geteuid() != 0) {
-            why_ = "not running as root";
-        } else if (::mount("tmpfs", where_.c_str(), "tmpfs", 0, "size=1m") != 0) {
-            why_ = std::string("mount -t tmpfs failed: ") + std::strerror(errno);
-        } else {
-            mounted_ = true;
-        }
-    }
-    ~SmallTmpfs() {
-        if (mounted_) ::umount2(where_.c_str(), MNT_DETACH);
-    }
-    bool mounted() const { return mounted_; }
-    const std::string& why() const { return why_; }
-
-    /// Fills the filesystem, then frees `spare` bytes again.
-    void fill_leaving(size_t spare) {
-        const std::string filler = where_ + "/filler";
-        std::FILE* f = std::fopen(filler.c_str(), "wb");
-        ASSERT_NE(f, nullptr);
-        std::vector<char> block(4096, 'f');
-        while (std::fwrite(block.data(), 1, block.size(), f) == block.size()) {}
-        std::fclose(f);
-        const auto size = std::filesystem::file_size(filler);
-        ASSERT_GT(size, spare);
-        std::filesystem::resize_file(filler, size - spare);
-    }
-
-private:
-    std::string where_, why_;
-    bool mounted_ = false;
-};
 
 TEST(HostileFullDisk, NoToolPublishesATruncatedFile) {
     ScratchDir dir("octiso_hostile_disk");

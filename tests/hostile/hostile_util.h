@@ -5,7 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/mount.h>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
 
 #include <algorithm>
 #include <cstdio>
@@ -77,5 +82,48 @@ inline void expect_refused(const RunResult& r, const std::string& subject, const
     const size_t lines = size_t(std::count(r.err.begin(), r.err.end(), '\n'));
     EXPECT_EQ(lines, 1u) << "expected exactly one stderr line: " << r.err;
 }
+
+/// OCTISO_REQUIRE_ALL=1 (CI): a test that cannot run its real check fails instead of skipping.
+inline bool required() {
+    const char* v = std::getenv("OCTISO_REQUIRE_ALL");
+    return v && std::string(v) == "1";
+}
+
+/// A tmpfs of 1 MiB mounted for one test (root only); why() says why not.
+class SmallTmpfs {
+public:
+    explicit SmallTmpfs(const std::string& where) : where_(where) {
+        std::filesystem::create_directories(where_);
+        if (::geteuid() != 0) {
+            why_ = "not running as root";
+        } else if (::mount("tmpfs", where_.c_str(), "tmpfs", 0, "size=1m") != 0) {
+            why_ = std::string("mount -t tmpfs failed: ") + std::strerror(errno);
+        } else {
+            mounted_ = true;
+        }
+    }
+    ~SmallTmpfs() {
+        if (mounted_) ::umount2(where_.c_str(), MNT_DETACH);
+    }
+    bool mounted() const { return mounted_; }
+    const std::string& why() const { return why_; }
+
+    /// Fills the filesystem, then frees `spare` bytes again.
+    void fill_leaving(size_t spare) {
+        const std::string filler = where_ + "/filler";
+        std::FILE* f = std::fopen(filler.c_str(), "wb");
+        ASSERT_NE(f, nullptr);
+        std::vector<char> block(4096, 'f');
+        while (std::fwrite(block.data(), 1, block.size(), f) == block.size()) {}
+        std::fclose(f);
+        const auto size = std::filesystem::file_size(filler);
+        ASSERT_GT(size, spare);
+        std::filesystem::resize_file(filler, size - spare);
+    }
+
+private:
+    std::string where_, why_;
+    bool mounted_ = false;
+};
 
 }  // namespace octiso::test
