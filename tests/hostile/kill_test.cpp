@@ -23,6 +23,10 @@ namespace {
 pid_t spawn(const std::vector<std::string>& argv) {
     const pid_t pid = ::fork();
     if (pid == 0) {
+        // A shell without job control starts background jobs with SIGINT and SIGQUIT ignored, and
+        // an ignored signal stays ignored across exec (octiso then keeps ignoring it, as it should):
+        // give the tool the default dispositions a user's terminal would.
+        for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) ::signal(sig, SIG_DFL);
         const int null = ::open("/dev/null", O_WRONLY);
         ::dup2(null, 1);
         ::dup2(null, 2);
