@@ -72,6 +72,11 @@ public:
     template <typename T> Octree<T> step(uint32_t k) const;
     /// Sizes of step k (validates it first, like step()).
     StepSizes step_sizes(uint32_t k) const;
+    /// Throws Error(path, ...) (bad input) if the file's size or modification time differs from
+    /// when it was opened: another program rewrote it in place, so what was read from the
+    /// mapping since is not what was validated (issue 18; policy in src/util/mapping_guard.h).
+    /// Tools call it before publishing anything computed from the file.
+    void check_unchanged() const;
 
 private:
     OctFile();

@@ -74,6 +74,15 @@ struct Placement {
     std::array<double, 3> origin{0.0, 0.0, 0.0};
 };
 
+/// Placement limits (issue 18): every spacing in [kMinSpacing, kMaxSpacing] (normal, with a
+/// normal square), every corner of the world box within +-kMaxWorldCoordinate (squared distances
+/// in camera framing and ray set-up stay finite), and voxels no smaller than 2^-40 of the box's
+/// largest coordinate (so that origin + i*spacing tells neighbouring voxels apart).
+inline constexpr double kMinSpacing = 1e-150, kMaxSpacing = 1e150, kMaxWorldCoordinate = 1e150;
+/// Throws Error(subject, ...) (bad input) unless `placement` of a `dims` grid is within those
+/// limits; `hint` is appended to the message (e.g. "; override it with --spacing").
+void check_placement(const Placement& placement, Dims dims, const std::string& subject, const std::string& hint = "");
+
 /// Non-owning x-fastest view of NX*NY*NZ scalars of type T, starting at `data`. The bytes may be
 /// unaligned (raw files with --offset) and of the other endianness (swap_bytes), so every load
 /// goes through memcpy; for aligned native data that compiles to a plain load.

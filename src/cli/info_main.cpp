@@ -14,17 +14,19 @@
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
 #include "format/oct_layout.h"
-#include "io/atomic_output.h"
+#include "util/atomic_output.h"
 #include "octiso/any_octree.h"
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
+#include "octiso/output_guard.h"
+#include "octiso/verify.h"
 
 namespace {
 
 using namespace octiso;
 
 constexpr const char* kUsage =
-    "usage: octiso-info FILE.oct [--json] [--extract-raw OUT.raw [--step K] [--endian little|big]]";
+    "usage: octiso-info FILE.oct [--json] [--verify] [--extract-raw OUT.raw [--step K] [--endian little|big]]";
 
 struct Extract {
     std::string path;
@@ -47,12 +49,8 @@ void extract_raw(const std::shared_ptr<const OctFile>& file, Extract& ex) {
     const AnyOctree step = AnyOctree::step(file, ex.step);
     std::vector<std::byte> data(size_t(ex.bytes));
     step.decode(data, ex.big_endian ? std::endian::big : std::endian::little);
-    AtomicOutput out(ex.path);
-    std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");
-    if (!f) throw Error(out.temp_path(), std::string("cannot create: ") + std::strerror(errno), ErrorKind::Other);
-    const bool ok = std::fwrite(data.data(), 1, size_t(ex.bytes), f) == size_t(ex.bytes);
-    if (std::fclose(f) != 0 || !ok) throw Error(ex.path, "write failed", ErrorKind::Other);
-    out.commit();
+    file->check_unchanged();   // issue 18: the decoded data came from what was validated
+    write_file_atomically(ex.path, data.data(), ex.bytes);   // every write, fsync and close checked
 }
 
 std::string join(const std::vector<uint64_t>& v) {
@@ -154,6 +152,7 @@ int main(int argc, char** argv) {
         cli::Args args(argv_rest);
         const bool json = args.flag("--json");
         const bool help = args.flag("--help") || args.flag("-h");
+        const bool verify = args.flag("--verify");
         const std::optional<std::string> extract_path = args.value("--extract-raw");
         const std::optional<std::string> step_text = args.value("--step");
         const std::optional<std::string> endian_text = args.value("--endian");
@@ -167,6 +166,7 @@ int main(int argc, char** argv) {
             throw Error("", std::string(files.empty() ? "no input file" : "more than one input file") + "; " + kUsage);
         if ((step_text || endian_text) && !extract_path)
             throw Error(step_text ? "--step" : "--endian", "only makes sense with --extract-raw");
+        if (extract_path) refuse_output_onto_input(*extract_path, files, "--extract-raw");   // issue 18
         Extract ex;
         if (extract_path) {
             ex.path = *extract_path;
@@ -186,6 +186,11 @@ int main(int argc, char** argv) {
         std::vector<StepSizes> steps;
         steps.reserve(file.info().step_count);
         for (uint32_t k = 0; k < file.info().step_count; ++k) steps.push_back(file.step_sizes(k));
+        if (verify) {   // issue 18: every min/max and scalar recomputed from the leaves; a lie exits 2
+            const VerifyStats v = verify_octree(file);
+            (json ? std::cerr : std::cout) << files[0] << ": verified " << v.nodes << " interior nodes, " << v.ranges
+                                           << " child ranges: every one agrees with the leaves\n";
+        }
         if (extract_path) extract_raw(shared_file, ex);
 
         const Extract* exp = extract_path ? &ex : nullptr;

@@ -15,6 +15,7 @@
 #include "octiso/error.h"
 #include "octiso/image.h"
 #include "octiso/oct_file.h"
+#include "octiso/output_guard.h"
 #include "octiso/render.h"
 
 namespace octiso {
@@ -93,6 +94,11 @@ int run(std::vector<std::string>& argv) {
     if (out_path) check_image_path(name_for(out_path, "-o", first), "-o");
     if (depth_path) check_image_path(name_for(depth_path, "--depth", first), "--depth");
     if (normal_path) check_image_path(name_for(normal_path, "--normal", first), "--normal");
+    for (long long k = first; k <= last; ++k) {   // issue 18: never replace the input
+        if (out_path) refuse_output_onto_input(name_for(out_path, "-o", k), inputs, "-o");
+        if (depth_path) refuse_output_onto_input(name_for(depth_path, "--depth", k), inputs, "--depth");
+        if (normal_path) refuse_output_onto_input(name_for(normal_path, "--normal", k), inputs, "--normal");
+    }
     const RenderLimits limits{info.iso_range, inputs[0]};
     validate_options(options, limits);
 
@@ -135,6 +141,7 @@ int run(std::vector<std::string>& argv) {
         Frame frame;
         const AnyOctree step = AnyOctree::step(file, uint32_t(k));
         step.make_renderer(options).render(camera, frame);
+        file->check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
         if (out_path) write_colour_image(name_for(out_path, "-o", k), frame);
         if (depth_path) write_depth_image(name_for(depth_path, "--depth", k), frame);
         if (normal_path) write_normal_image(name_for(normal_path, "--normal", k), frame);

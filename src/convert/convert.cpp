@@ -11,6 +11,7 @@
 #include "convert/same_grid.h"
 #include "octiso/any_octree.h"
 #include "octiso/convert.h"
+#include "octiso/output_guard.h"
 #include "octree/sparse_synthetic.h"
 #include "util/process_memory.h"
 
@@ -66,6 +67,11 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     using convert_detail::GridOfStep;
     const Clock::time_point t_start = Clock::now();
     if (source.is_sparse_spheres()) return convert_sparse_spheres(source, output, t_start);
+    if (!source.is_synthetic()) {   // never replace an input (issue 18: same device and inode)
+        std::vector<std::string> inputs;
+        for (uint32_t i = 0; i < source.step_count(); ++i) inputs.push_back(source.step_path(i));
+        refuse_output_onto_input(output, inputs);
+    }
     std::optional<tbb::global_control> limit;   // reading, generating and building alike
     if (options.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(options.threads));
 

@@ -14,6 +14,7 @@
 
 #include "format/oct_layout.h"
 #include "format/validate.h"
+#include "util/mapping_guard.h"
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
 
@@ -44,12 +45,17 @@ struct OctFile::Impl {
     Verify verify = Verify::Full;
     const std::byte* base = nullptr;   // the whole file, mapped read-only
     uint64_t bytes = 0;
+    int fd = -1;         // kept open: holds the shared flock, and the fault handler fstats it
+    int guard_slot = -1; // io::register_mapping slot (mapping_guard.h)
+    struct stat opened {};   // fstat at open, for check_unchanged()
     OctInfo info;
     const SectionEntry* table = nullptr;   // step_count * dmax entries, (step, depth) order
     std::unique_ptr<StepState[]> steps;
 
     ~Impl() {
+        io::unregister_mapping(guard_slot);
         if (base) ::munmap(const_cast<std::byte*>(base), size_t(bytes));
+        if (fd >= 0) ::close(fd);
     }
 
     [[noreturn]] void fail(const std::string& problem) const { throw Error(path, problem); }
@@ -97,30 +103,29 @@ struct OctFile::Impl {
     }
 };
 
-// 1. Map: the file is never read through anything but this read-only mapping.
+// 1. Map: the file is never read through anything but this read-only mapping. The descriptor
+//    stays open with a shared flock for the mapping's lifetime (policy in util/mapping_guard.h).
 void OctFile::Impl::map_file() {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw Error(path, std::string("cannot open: ") + std::strerror(errno));
+    // O_NONBLOCK: opening a FIFO for reading blocks until a writer appears (issue 18: a hang);
+    // non-blocking it returns at once, and fstat below refuses anything but a regular file.
+    fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) {
+        if (errno == ENOENT || errno == ENOTDIR) fail("no such file");
+        throw Error(path, std::string("cannot open: ") + std::strerror(errno));
+    }
     struct stat st {};
-    if (::fstat(fd, &st) != 0) {
-        const int e = errno;
-        ::close(fd);
-        throw Error(path, std::string("cannot stat: ") + std::strerror(e));
-    }
-    if (!S_ISREG(st.st_mode)) {
-        ::close(fd);
-        fail("not a regular file");
-    }
+    if (::fstat(fd, &st) != 0) throw Error(path, std::string("cannot stat: ") + std::strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        fail(S_ISDIR(st.st_mode) ? "is a directory, not a .oct file" : "is not a regular file (a FIFO, socket or device)");
+    io::lock_shared_or_refuse(fd, path);
+    opened = st;
     bytes = uint64_t(st.st_size);
-    if (bytes < sizeof(FileHeader)) {
-        ::close(fd);
+    if (bytes < sizeof(FileHeader))
         fail("too short to be a .oct file (expected at least " + num(sizeof(FileHeader)) + " bytes, found " + num(bytes) + ")");
-    }
     void* p = ::mmap(nullptr, size_t(bytes), PROT_READ, MAP_PRIVATE, fd, 0);
-    const int e = errno;
-    ::close(fd);   // the mapping keeps the file alive
-    if (p == MAP_FAILED) throw Error(path, std::string("cannot map: ") + std::strerror(e), ErrorKind::Other);
+    if (p == MAP_FAILED) throw Error(path, std::string("cannot map: ") + std::strerror(errno), ErrorKind::Other);
     base = static_cast<const std::byte*>(p);
+    guard_slot = io::register_mapping(base, bytes, fd, path);
 }
 
 // 2. Header: identity first (magic, endianness, version, size), then its checksum, then fields.
@@ -158,11 +163,10 @@ void OctFile::Impl::check_header() {
         fail("dmax does not match the grid " + num(h.dims[0]) + "x" + num(h.dims[1]) + "x" + num(h.dims[2]) +
              " (expected " + num(info.dmax) + ", found " + num(h.dmax) + ")");
     for (int i = 0; i < 3; ++i) {
-        if (!std::isfinite(h.spacing[i]) || !(h.spacing[i] > 0)) fail("spacing must be finite and positive");
-        if (!std::isfinite(h.origin[i])) fail("origin must be finite");
         info.placement.spacing[size_t(i)] = h.spacing[i];
         info.placement.origin[size_t(i)] = h.origin[i];
     }
+    check_placement(info.placement, info.dims, path);   // finite, in range, a finite world box
     if (h.has_iso_range > 1) fail("bad iso-range flag (expected 0 or 1, found " + num(h.has_iso_range) + ")");
     if (h.has_iso_range) {
         if (!std::isfinite(h.iso_range[0]) || !std::isfinite(h.iso_range[1]) || !(h.iso_range[0] < h.iso_range[1]))
@@ -287,6 +291,14 @@ template <typename T> Octree<T> OctFile::step(uint32_t k) const {
 }
 
 StepSizes OctFile::step_sizes(uint32_t k) const { return impl_->ensure_valid(k); }
+
+void OctFile::check_unchanged() const {
+    struct stat st {};
+    const Impl& m = *impl_;
+    if (::fstat(m.fd, &st) != 0 || st.st_size != m.opened.st_size || st.st_mtim.tv_sec != m.opened.st_mtim.tv_sec ||
+        st.st_mtim.tv_nsec != m.opened.st_mtim.tv_nsec)
+        m.fail("the file changed while it was being read (rewritten in place by another program); nothing was written");
+}
 
 #define OCTISO_INSTANTIATE(T) template Octree<T> OctFile::step<T>(uint32_t) const;
 OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)

@@ -11,7 +11,7 @@
 
 #include "format/oct_layout.h"
 #include "format/validate.h"
-#include "io/atomic_output.h"
+#include "util/atomic_output.h"
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
 
@@ -76,11 +76,7 @@ OctWriter::OctWriter(std::string path, const OctInfo& info) : impl_(std::make_un
                            std::to_string(info.dmax) + ")");
     m.info.dmax = dmax_for(info.dims);
     m.info.step_count = 0;
-    for (int i = 0; i < 3; ++i) {
-        if (!std::isfinite(info.placement.spacing[size_t(i)]) || !(info.placement.spacing[size_t(i)] > 0))
-            throw Error(p, "spacing must be finite and positive");
-        if (!std::isfinite(info.placement.origin[size_t(i)])) throw Error(p, "origin must be finite");
-    }
+    check_placement(info.placement, info.dims, p);
     if (info.iso_range && !((*info.iso_range)[0] < (*info.iso_range)[1] && std::isfinite((*info.iso_range)[0]) &&
                             std::isfinite((*info.iso_range)[1])))
         throw Error(p, "iso-range must be finite with LO < HI");
@@ -168,7 +164,7 @@ void OctWriter::finish() {
     const int rc = std::fclose(m.file);
     m.file = nullptr;
     if (rc != 0) m.fail_io("close failed");
-    m.out.commit();
+    m.out.commit(int64_t(m.pos));
     m.finished = true;
 }
 

@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
-#include "io/atomic_output.h"
+#include "util/atomic_output.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
 
@@ -15,12 +16,26 @@ namespace {
 
 void write_image(const std::string& path, int width, int height, int channels, OIIO::TypeDesc type, const void* pixels,
                  const std::vector<std::string>& names, OIIO::TypeDesc file_type) {
-    AtomicOutput out(path);
     auto file = OIIO::ImageOutput::create(path);
     if (!file) throw Error(path, "no image format for this extension (" + OIIO::geterror() + ")");
     OIIO::ImageSpec spec(width, height, channels, file_type);
     spec.channelnames = names;
     if (channels == 1) spec.alpha_channel = -1, spec.z_channel = 0;
+    // Encode into memory, then write the bytes ourselves with every write checked: OIIO's PNG
+    // writer did not report ENOSPC, and a truncated PNG was renamed into place (issue 18).
+    if (file->supports("ioproxy")) {
+        std::vector<unsigned char> bytes;
+        OIIO::Filesystem::IOVecOutput memory(bytes);
+        if (!file->set_ioproxy(&memory) || !file->open(path, spec))
+            throw Error(path, "cannot encode: " + file->geterror(), ErrorKind::Other);
+        if (!file->write_image(type, pixels)) throw Error(path, "encoding failed: " + file->geterror(), ErrorKind::Other);
+        if (!file->close()) throw Error(path, "encoding failed: " + file->geterror(), ErrorKind::Other);
+        write_file_atomically(path, bytes.data(), bytes.size());
+        return;
+    }
+    // A format without I/O proxies writes its own file; commit() still fsyncs it (which reports
+    // deferred write errors) before the rename.
+    AtomicOutput out(path);
     if (!file->open(out.temp_path(), spec)) throw Error(path, "cannot open for writing: " + file->geterror(), ErrorKind::Other);
     if (!file->write_image(type, pixels)) throw Error(path, "write failed: " + file->geterror(), ErrorKind::Other);
     if (!file->close()) throw Error(path, "close failed: " + file->geterror(), ErrorKind::Other);

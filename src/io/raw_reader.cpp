@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "io/input_file.h"
+#include "util/mapping_guard.h"
 #include "octiso/reader.h"
 
 namespace octiso {
@@ -39,10 +40,12 @@ LoadedVolume read_raw(const std::string& path, Dims dims, ScalarType type, Endia
 
     // 2. The file: exists, regular, readable, non-empty, and exactly offset + bytes long.
     io::check_input_file(path);
-    const FdCloser fd{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
+    // O_NONBLOCK, then fstat: the path may have been swapped for a FIFO since the check above.
+    const FdCloser fd{::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)};
     if (fd.fd < 0) throw Error(path, std::string("cannot open: ") + std::strerror(errno));
     struct stat st {};
     if (::fstat(fd.fd, &st) != 0) throw Error(path, std::string("cannot stat: ") + std::strerror(errno));
+    if (!S_ISREG(st.st_mode)) throw Error(path, "is not a regular file");
     const uint64_t file_bytes = uint64_t(st.st_size);
     if (file_bytes == 0) throw Error(path, "empty file");
     if (offset > file_bytes)
@@ -54,9 +57,23 @@ LoadedVolume read_raw(const std::string& path, Dims dims, ScalarType type, Endia
                               ", found " + std::to_string(file_bytes - offset) + ")");
 
     // 3. Map the whole file (mmap offsets must be page aligned; --offset need not be).
+    //    The mapping is guarded like a .oct file's (util/mapping_guard.h): a shared flock, and a
+    //    clean one-line exit if the file is truncated or rewritten while it is being read.
+    io::lock_shared_or_refuse(fd.fd, path);
     void* base = ::mmap(nullptr, size_t(file_bytes), PROT_READ, MAP_PRIVATE, fd.fd, 0);
-    if (base == MAP_FAILED) throw Error(path, std::string("cannot map: ") + std::strerror(errno), ErrorKind::Other);
-    std::shared_ptr<const void> owner(base, [file_bytes](const void* p) { ::munmap(const_cast<void*>(p), size_t(file_bytes)); });
+    if (base == MAP_FAILED) {
+        if (errno == ENOMEM)   // the declared grid does not fit the address space allowed (ulimit -v)
+            throw Error(path, "out of memory mapping " + std::to_string(file_bytes) + " bytes (" + dims_text(dims) + " " +
+                                  std::string(scalar_type_name(type)) + ")");
+        throw Error(path, std::string("cannot map: ") + std::strerror(errno), ErrorKind::Other);
+    }
+    const int kept_fd = ::fcntl(fd.fd, F_DUPFD_CLOEXEC, 0);   // the flock belongs to the open file, shared by the dup
+    const int slot = kept_fd >= 0 ? io::register_mapping(base, file_bytes, kept_fd, path) : -1;
+    std::shared_ptr<const void> owner(base, [file_bytes, kept_fd, slot](const void* p) {
+        io::unregister_mapping(slot);
+        ::munmap(const_cast<void*>(p), size_t(file_bytes));
+        if (kept_fd >= 0) ::close(kept_fd);
+    });
 
     const bool native_little = std::endian::native == std::endian::little;
     const bool swap = scalar_type_bytes(type) > 1 && (endian == Endian::little) != native_little;

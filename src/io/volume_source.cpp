@@ -56,8 +56,13 @@ std::optional<VolumeFormat> format_from_extension(const std::string& path) {
 // header and image names from it.
 std::optional<VolumeFormat> format_from_magic(const std::string& path) {
     char head[512] = {};
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) return std::nullopt;
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        ::close(fd);
+        return std::nullopt;
+    }
     const ssize_t n = ::read(fd, head, sizeof head - 1);
     ::close(fd);
     if (n <= 0) return std::nullopt;
@@ -72,16 +77,6 @@ std::optional<VolumeFormat> format_from_magic(const std::string& path) {
     if (n >= 348 && text.substr(344, 4) == std::string_view("n+1\0", 4)) return VolumeFormat::nifti;
     if (n >= 8 && text.substr(4, 4) == std::string_view("n+2\0", 4)) return VolumeFormat::nifti;
     return std::nullopt;
-}
-
-void check_placement(const Placement& p, const std::string& path) {
-    for (int a = 0; a < 3; ++a) {
-        if (!std::isfinite(p.spacing[size_t(a)]) || !(p.spacing[size_t(a)] > 0))
-            throw Error(path, "spacing must be finite and positive (found " + std::to_string(p.spacing[0]) + "," +
-                                  std::to_string(p.spacing[1]) + "," + std::to_string(p.spacing[2]) +
-                                  "); override it with --spacing");
-        if (!std::isfinite(p.origin[size_t(a)])) throw Error(path, "origin is not finite; override it with --origin");
-    }
 }
 
 }  // namespace
@@ -133,7 +128,7 @@ LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
     Placement placement = volume.placement();
     if (options.spacing) placement.spacing = *options.spacing;
     if (options.origin) placement.origin = *options.origin;
-    check_placement(placement, path);
+    check_placement(placement, volume.dims(), path, "; override it with --spacing/--origin");
     volume.set_placement(placement);
     return volume;
 }

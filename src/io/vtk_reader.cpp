@@ -4,6 +4,8 @@
 // and the output is checked (dims, one component, array length) before anyone trusts it. The
 // scalar array stays alive inside the LoadedVolume: no copy of the voxels is made.
 #include <iostream>
+#include <new>
+#include <stdexcept>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -25,6 +27,7 @@
 #include <vtkType.h>
 #include <vtkXMLImageDataReader.h>
 
+#include "io/header_check.h"
 #include "io/input_file.h"
 #include "octiso/reader.h"
 
@@ -159,6 +162,7 @@ namespace octiso {
 
 LoadedVolume read_vtk(const std::string& path, VolumeFormat format) {
     io::check_input_file(path);
+    io::check_declared_size(path, format);   // before VTK: bad datatypes crash it, short data is zero-filled
     silence_vtk();
     const std::string what = "cannot read as " + std::string(volume_format_name(format)) + ": ";
 
@@ -180,7 +184,13 @@ LoadedVolume read_vtk(const std::string& path, VolumeFormat format) {
     {
         std::optional<StdStreamsMuted> muted;
         if (format == VolumeFormat::meta_image) muted.emplace();
-        reader->Update();
+        try {
+            reader->Update();
+        } catch (const std::bad_alloc&) {
+            throw Error(path, what + "out of memory reading the voxels the header declares");
+        } catch (const std::length_error&) {
+            throw Error(path, what + "the header declares more voxels than can be allocated");
+        }
     }
     const std::string window_text = std::move(t_vtk_window_text);
     t_vtk_window_text.clear();

@@ -268,11 +268,19 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
 }  // namespace
 
 template <typename T> OctreeData<T> build_octree(const VolumeView<T>& volume, const BuildOptions& options) {
-    if (options.threads > 0) {
-        tbb::task_arena arena(options.threads);
-        return arena.execute([&] { return build_impl(volume, options); });
+    try {
+        if (options.threads > 0) {
+            tbb::task_arena arena(options.threads);
+            return arena.execute([&] { return build_impl(volume, options); });
+        }
+        return build_impl(volume, options);
+    } catch (const std::bad_alloc&) {
+        // Issue 18: a huge declared grid ran out of memory without naming its file.
+        const Dims d = volume.dims;
+        throw Error(options.source_name, "out of memory building the octree of this " + std::to_string(d.x) + "x" +
+                                             std::to_string(d.y) + "x" + std::to_string(d.z) + " " +
+                                             std::string(scalar_type_name(scalar_type_of<T>())) + " volume");
     }
-    return build_impl(volume, options);
 }
 
 #define OCTISO_INSTANTIATE(T)                                                               \

@@ -316,17 +316,36 @@ template <class F> decltype(auto) dispatch_root_finder(RootFinder kind, int iter
 /// World-space unit normal of the isosurface at p_cell: the gradient of the trilinear interpolant
 /// (per index step) divided by the spacing per axis, normalised, and flipped to face the ray
 /// (dot(n, ray_dir) <= 0). A zero or non-finite gradient gives -ray_dir (CONVENTIONS 2b).
+/// Finite for every finite input: the corners are scaled by a power of two before they are
+/// differenced (values near +-DBL_MAX would otherwise overflow to inf and mix to NaN, issue 18),
+/// and the spacing enters as the ratio smallest/own (<= 1), never as a division that overflows.
 inline std::array<double, 3> world_normal(const double c[8], const std::array<double, 3>& p_cell,
                                           const std::array<double, 3>& spacing, const std::array<double, 3>& ray_dir) {
-    const std::array<double, 3> g = gradient(c, p_cell);
-    std::array<double, 3> n{g[0] / spacing[0], g[1] / spacing[1], g[2] / spacing[2]};
-    // Scale by the largest component first, so huge or tiny values neither overflow nor underflow.
+    const std::array<double, 3> fallback{-ray_dir[0], -ray_dir[1], -ray_dir[2]};
+    // 1. Scale the corners so that |c| <= 2^-2: differences stay <= 2^-1 and the lerps below
+    //    (weights in [0,1], slightly outside for an extrapolated p_cell) cannot overflow.
+    double big_c = 0;
+    for (int i = 0; i < 8; ++i) big_c = std::fmax(big_c, std::fabs(c[i]));
+    if (!std::isfinite(big_c) || !(big_c > 0)) return fallback;
+    int e = 0;
+    std::frexp(big_c, &e);   // big_c < 2^e
+    double cs[8];
+    for (int i = 0; i < 8; ++i) cs[i] = std::ldexp(c[i], -e - 2);
+    const std::array<double, 3> g = gradient(cs, p_cell);
+    // 2. Per world unit: g_a / s_a, up to the common factor 1/s_min, which the normalisation drops.
+    const double s_min = std::fmin(spacing[0], std::fmin(spacing[1], spacing[2]));
+    std::array<double, 3> n{g[0] * (s_min / spacing[0]), g[1] * (s_min / spacing[1]), g[2] * (s_min / spacing[2])};
+    for (double v : n)
+        if (!std::isfinite(v)) return fallback;   // fmax below would hide a NaN component
+    // 3. Scale by the largest component, so tiny values do not underflow in the squares.
     const double big = std::fmax(std::fabs(n[0]), std::fmax(std::fabs(n[1]), std::fabs(n[2])));
-    if (!(big > 0) || !std::isfinite(big)) return {-ray_dir[0], -ray_dir[1], -ray_dir[2]};
+    if (!(big > 0)) return fallback;
     for (double& v : n) v /= big;
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     const double flip = (n[0] * ray_dir[0] + n[1] * ray_dir[1] + n[2] * ray_dir[2]) > 0 ? -1.0 : 1.0;
     for (double& v : n) v *= flip / len;
+    for (double v : n)
+        if (!std::isfinite(v)) return fallback;
     return n;
 }
 

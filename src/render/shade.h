@@ -32,7 +32,9 @@ public:
         }
     }
     uint8_t operator()(float linear) const {
-        const float c = std::clamp(linear, 0.0f, 1.0f);
+        // Written so that NaN maps to 0 (std::clamp passes NaN through, and int(NaN) is
+        // undefined: it indexed the table at INT_MIN, issue 18).
+        const float c = linear > 0.0f ? (linear < 1.0f ? linear : 1.0f) : 0.0f;
         return table_[int(c * float(kSize - 1) + 0.5f)];
     }
     static const SrgbTable& instance() {

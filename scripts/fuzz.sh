@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets in fuzz/ with clang (ASan+UBSan, in build-fuzz/ or
+# $OCTISO_FUZZ_BUILD_DIR) and runs each one on a scratch copy of its committed seed corpus.
+#   scripts/fuzz.sh [SECONDS]        each target for SECONDS (default 45: the CI smoke run)
+#   FUZZ_RUNS=1000000 scripts/fuzz.sh  each target for exactly that many executions instead
+# Exit status: non-zero if any target found a crash, leak, timeout or sanitizer report; the
+# reproducer is left in build-fuzz/findings/<target>/.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${OCTISO_FUZZ_BUILD_DIR:-$root/build-fuzz}
+seconds=${1:-45}
+targets="oct_loader raw_reader nifti_header render"
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=${CXX_FUZZ:-clang++} \
+  -DOCTISO_FUZZ=ON -DOCTISO_BUILD_BENCH=OFF ${OCTISO_CMAKE_ARGS:-} >/dev/null
+cmake --build "$build" -j "${OCTISO_JOBS:-$(nproc)}" $(for t in $targets; do echo --target fuzz_$t; done)
+status=0
+for t in $targets; do
+  work="$build/corpus/$t" findings="$build/findings/$t"
+  rm -rf "$work" && mkdir -p "$work" "$findings"
+  limit=(-max_total_time="$seconds")
+  [ -n "${FUZZ_RUNS:-}" ] && limit=(-runs="$FUZZ_RUNS")
+  echo "== fuzz_$t ${limit[*]}"
+  # detect_leaks=0: TBB's and Embree's process-lifetime allocations are not findings.
+  if ! ASAN_OPTIONS=detect_leaks=0:${ASAN_OPTIONS:-} "$build/fuzz/fuzz_$t" "${limit[@]}" -timeout=10 -rss_limit_mb=4096 \
+      -print_final_stats=1 -artifact_prefix="$findings/" "$work" "$root/fuzz/corpus/$t" 2>"$build/fuzz_$t.log"; then
+    status=1
+    echo "fuzz_$t: FINDING (see $build/fuzz_$t.log and $findings/)"
+  fi
+  grep -E "stat::number_of_executed_units|stat::peak_rss_mb|Done [0-9]+ runs" "$build/fuzz_$t.log" || true
+done
+exit $status
