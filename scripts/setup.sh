@@ -8,7 +8,7 @@ packages=(
   libtbb-dev libembree-dev libopenimageio-dev openimageio-tools libvtk9-dev
   libgtest-dev libbenchmark-dev libxxhash-dev zstd libzstd-dev
   libopenvdb-dev libboost-iostreams-dev mricron-data
-  python3-numpy python3-matplotlib python3-dev pybind11-dev python3-pytest python3-nibabel
+  python3-numpy python3-matplotlib python3-dev pybind11-dev python3-pytest python3-nibabel clang
 )
 
 missing=()

@@ -22,7 +22,7 @@
 #include <string_view>
 #include <vector>
 
-#include "octiso/reader.h"
+#include "octiso/loaded_volume.h"
 #include "octiso/volume.h"
 
 namespace octiso {

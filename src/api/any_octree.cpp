@@ -13,7 +13,7 @@
 #include "octiso/debug_trace.h"
 #include "octiso/decode.h"
 #include "octiso/error.h"
-#include "octiso/reader.h"
+#include "octiso/loaded_volume.h"
 
 namespace octiso {
 

@@ -1,7 +1,7 @@
 // LoadedVolume's constructor and the format names of reader.h. They live in the core library
 // (not with the readers in src/io) because the synthetic generators of src/volume make
 // LoadedVolumes too, and the core must link without VTK or OpenImageIO.
-#include "octiso/reader.h"
+#include "octiso/loaded_volume.h"
 
 namespace octiso {
 
