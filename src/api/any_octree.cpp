@@ -161,14 +161,15 @@ int AnyOctree::dmax() const { return impl_->dmax(); }
 const std::shared_ptr<const OctFile>& AnyOctree::file() const { return impl_->file; }
 
 AnyOctreeInfo AnyOctree::info() const {
+    const OctInfo header = oct_info();
     AnyOctreeInfo i;
-    i.type = type();
-    i.dims = dims();
-    i.placement = impl_->placement;
-    i.dmax = dmax();
+    i.type = header.type;
+    i.dims = header.dims;
+    i.placement = header.placement;
+    i.dmax = header.dmax;
+    i.iso_range = header.iso_range;
+    i.tolerance = header.tolerance;
     i.sizes = impl_->sizes();
-    i.iso_range = impl_->iso_range;
-    i.tolerance = impl_->tolerance;
     i.value_range = impl_->value_range();
     i.dense_bytes = dense_bytes();
     i.source = impl_->source;

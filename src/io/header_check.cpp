@@ -20,6 +20,21 @@ namespace octiso::io {
 
 namespace {
 
+/// A whitespace-separated list of extents ("sizes: 12 5 4"), each a decimal integer of at most 18
+/// digits (so the product check cannot be fooled by an overflowing parse); `what` names the field.
+std::vector<uint64_t> parse_sizes(const std::string& text, const std::string& what, const std::string& path) {
+    std::vector<uint64_t> sizes;
+    std::istringstream ss(text);
+    std::string tok;
+    while (ss >> tok) {
+        if (tok.find_first_not_of("0123456789") != std::string::npos || tok.size() > 18)
+            throw Error(path, what + " '" + text + "' are not positive integers");
+        sizes.push_back(std::stoull(tok));
+    }
+    if (sizes.empty()) throw Error(path, what + " field is empty");
+    return sizes;
+}
+
 constexpr uint64_t kDeflateMaxRatio = 1032;
 constexpr size_t kHeaderLimit = 1 << 16;
 
@@ -156,15 +171,7 @@ void check_nrrd(const std::string& path) {
     if (!field.count("sizes") || !field.count("type")) return;   // VTK will say what is missing
     const int tb = nrrd_type_bytes(field["type"]);
     if (tb == 0) throw Error(path, "NRRD type '" + field["type"] + "' is not supported");
-    std::vector<uint64_t> sizes;
-    std::istringstream ss(field["sizes"]);
-    std::string tok;
-    while (ss >> tok) {
-        if (tok.find_first_not_of("0123456789") != std::string::npos || tok.size() > 18)
-            throw Error(path, "NRRD sizes '" + field["sizes"] + "' are not positive integers");
-        sizes.push_back(std::stoull(tok));
-    }
-    if (sizes.empty()) throw Error(path, "NRRD sizes field is empty");
+    const std::vector<uint64_t> sizes = parse_sizes(field["sizes"], "NRRD sizes", path);
     const uint64_t declared = product(sizes, uint64_t(tb), path);
     const std::string enc = lower(field.count("encoding") ? field["encoding"] : "raw");
     uint64_t available = 0;
@@ -278,15 +285,7 @@ void check_meta_image(const std::string& path) {
     if (data_at < 0 || !field.count("DimSize") || !field.count("ElementType")) return;   // VTK reports it
     const int tb = met_type_bytes(field["ElementType"]);
     if (tb == 0) throw Error(path, "MetaImage ElementType '" + field["ElementType"] + "' is not supported");
-    std::vector<uint64_t> sizes;
-    std::istringstream ss(field["DimSize"]);
-    std::string tok;
-    while (ss >> tok) {
-        if (tok.find_first_not_of("0123456789") != std::string::npos || tok.size() > 18)
-            throw Error(path, "MetaImage DimSize '" + field["DimSize"] + "' is not positive integers");
-        sizes.push_back(std::stoull(tok));
-    }
-    if (sizes.empty()) throw Error(path, "MetaImage DimSize is empty");
+    std::vector<uint64_t> sizes = parse_sizes(field["DimSize"], "MetaImage DimSize", path);
     if (field.count("ElementNumberOfChannels")) sizes.push_back(std::strtoull(field["ElementNumberOfChannels"].c_str(), nullptr, 10));
     const uint64_t declared = product(sizes, uint64_t(tb), path);
     const bool compressed = lower(field["CompressedData"]) == "true";
