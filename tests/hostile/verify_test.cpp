@@ -38,6 +38,7 @@ TEST(HostileVerify, FilesOctisoWritesVerify) {
 /// The forgery: min > max in every node, checksums recomputed, so the loader accepts it.
 TEST(HostileVerify, InvertedRangesInEveryNodeAreReported) {
     ScratchDir dir;
+    dir.allow_lying_metadata();   // the forgeries are the point
     const std::string good = dir.file("good.oct"), bad = dir.file("bad.oct");
     ASSERT_EQ(run_shell("'" + kTools + "/octiso-convert' --synthetic sphere:24 --type u8 -o '" + good + "' 2>/dev/null"), 0);
     OctBytes b(good);
@@ -67,6 +68,7 @@ TEST(HostileVerify, InvertedRangesInEveryNodeAreReported) {
 /// Subtler lies: one deep range narrowed by one, and one interior child's scalar moved out of range.
 TEST(HostileVerify, OneNarrowedRangeOrMisplacedScalarIsReported) {
     ScratchDir dir;
+    dir.allow_lying_metadata();   // the forgeries are the point
     const std::string good = dir.file("good.oct");
     ASSERT_EQ(run_shell("'" + kTools + "/octiso-convert' --synthetic noise:32 --type u8 -o '" + good + "' 2>/dev/null"), 0);
     const OctBytes original(good);

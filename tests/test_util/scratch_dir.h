@@ -1,16 +1,27 @@
 // ScratchDir: a fresh directory under the system temp dir for one test, removed with everything
 // in it when the test ends. entries() lets CLI tests assert that a failed run left nothing behind.
+// Before removal every .oct file left in it that passes the loader's validation is checked with
+// verify_octree() (octiso-info --verify, issue 18): each min/max and scalar recomputed from the
+// leaves, so no test writes a file whose metadata lies without failing. Files that fail
+// validation are the rejection tests' own business; a test that forges lying metadata on purpose
+// says so with allow_lying_metadata(). Steps larger than kVerifyBytes as dense arrays are skipped.
 // The one ScratchDir of the test binary (every suite includes this header; a second class of the
 // same name elsewhere would be an ODR violation).
 #pragma once
 
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <algorithm>
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "octiso/error.h"
+#include "octiso/oct_file.h"
+#include "octiso/verify.h"
 
 namespace octiso::test {
 
@@ -23,9 +34,12 @@ public:
         std::filesystem::create_directories(path_);
     }
     ~ScratchDir() {
+        if (!lies_allowed_) verify_octree_files();
         std::error_code ec;
         std::filesystem::remove_all(path_, ec);
     }
+    /// For tests that write files with valid checksums and lying min/max on purpose.
+    void allow_lying_metadata() { lies_allowed_ = true; }
     ScratchDir(const ScratchDir&) = delete;
     ScratchDir& operator=(const ScratchDir&) = delete;
 
@@ -40,7 +54,32 @@ public:
     }
 
 private:
+    static constexpr uint64_t kVerifyBytes = uint64_t(64) << 20;
+
+    void verify_octree_files() const {
+        std::error_code ec;
+        for (const auto& e : std::filesystem::recursive_directory_iterator(path_, ec)) {
+            if (!e.is_regular_file() || e.path().extension() != ".oct") continue;
+            const std::string p = e.path().string();
+            try {
+                const OctFile f = OctFile::open(p);
+                const Dims d = f.info().dims;   // in double: a 2^30-cubed grid overflows 64 bits
+                if (double(d.x) * double(d.y) * double(d.z) * double(scalar_type_bytes(f.info().type)) > double(kVerifyBytes))
+                    continue;
+                for (uint32_t k = 0; k < f.info().step_count; ++k) (void)f.step_sizes(k);   // validates each step
+                try {
+                    (void)verify_octree(f);
+                } catch (const Error& lie) {
+                    ADD_FAILURE() << "a test wrote a file whose metadata lies (octiso-info --verify): " << lie.what();
+                }
+            } catch (const Error&) {
+                // Not a valid .oct file: refused by the loader, which is what rejection tests check.
+            }
+        }
+    }
+
     std::filesystem::path path_;
+    bool lies_allowed_ = false;
 };
 
 }  // namespace octiso::test
