@@ -7,6 +7,7 @@
 #include <string>
 
 #include "test_util/run_shell.h"
+#include "test_util/skip.h"
 #include "test_util/scratch_dir.h"
 
 namespace octiso::test {
@@ -18,7 +19,9 @@ const std::string kTools = OCTISO_TOOLS_DIR;
 class DebugPixelCli : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!fs::exists(kTools + "/octiso-render") || !fs::exists(kTools + "/octiso-convert")) GTEST_SKIP() << "tools not built";
+        if (!fs::exists(kTools + "/octiso-render") || !fs::exists(kTools + "/octiso-convert")) {
+            OCTISO_SKIP("tools not built");
+        }
         ASSERT_EQ(run("'" + kTools + "/octiso-convert' --synthetic sphere:24 -o '" + oct_ + "'"), 0);
     }
     int run(const std::string& command, std::string* out = nullptr, std::string* err = nullptr) {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "test_util/skip.h"
 #include "test_util/scratch_dir.h"
 
 namespace octiso::test {
@@ -83,11 +84,9 @@ inline void expect_refused(const RunResult& r, const std::string& subject, const
     EXPECT_EQ(lines, 1u) << "expected exactly one stderr line: " << r.err;
 }
 
-/// OCTISO_REQUIRE_ALL=1 (CI): a test that cannot run its real check fails instead of skipping.
-inline bool required() {
-    const char* v = std::getenv("OCTISO_REQUIRE_ALL");
-    return v && std::string(v) == "1";
-}
+/// OCTISO_REQUIRE_ALL=1 (CI): a test that cannot run its real check fails instead of skipping
+/// (the one rule of test_util/skip.h).
+inline bool required() { return skips_must_fail(); }
 
 /// A tmpfs of 1 MiB mounted for one test (root only); why() says why not.
 class SmallTmpfs {
