@@ -52,9 +52,9 @@ RenderOptions options_of(const py::object& iso, int threads, bool depth, bool no
     return o;
 }
 
-/// The camera for a frame of `size`: the given one resized, or the default framing of `tree`.
-Camera camera_for(const AnyOctree& tree, const std::optional<Camera>& camera, const py::object& size) {
-    const auto [w, h] = size_of(size);
+/// The camera for a frame of w x h: the given one resized, or the default framing of `tree`.
+Camera camera_for(const AnyOctree& tree, const std::optional<Camera>& camera, std::array<int, 2> wh) {
+    const auto [w, h] = wh;
     if (camera) {
         Camera c = *camera;
         c.width = w, c.height = h;
@@ -83,7 +83,7 @@ PyFrame to_python(Frame&& f) {
 struct PyRenderer {
     AnyOctree tree;
     Renderer renderer;
-    py::object size;
+    std::array<int, 2> size;   ///< frame width, height
 };
 
 }  // namespace
@@ -137,12 +137,9 @@ Without angles: the same three-quarter view as octiso-render without camera flag
         .def(py::init([](const AnyOctree& tree, const py::object& iso, const py::object& size, int threads, bool depth, bool normal,
                          const std::string& root_finder, int iterations) {
                  const RenderOptions o = options_of(iso, threads, depth, normal, root_finder, iterations);
-                 size_of(size);
+                 const std::array<int, 2> wh = size_of(size);
                  py::gil_scoped_release release;
-                 auto r = std::make_unique<PyRenderer>(PyRenderer{tree, tree.make_renderer(o), py::object()});
-                 py::gil_scoped_acquire acquire;
-                 r->size = size;
-                 return r;
+                 return std::make_unique<PyRenderer>(PyRenderer{tree, tree.make_renderer(o), wh});
              }),
              py::arg("tree"), py::arg("iso"), py::arg("size") = py::make_tuple(512, 512), py::arg("threads") = 0,
              py::arg("depth") = false, py::arg("normal") = false, py::arg("root_finder") = "neubauer", py::arg("iterations") = -1)
@@ -170,7 +167,7 @@ void add_tree_render(py::class_<AnyOctree>& tree_class) {
         [](const AnyOctree& tree, const py::object& iso, const std::optional<Camera>& camera, const py::object& size, int threads,
            bool depth, bool normal, const std::string& root_finder) {
             const RenderOptions o = options_of(iso, threads, depth, normal, root_finder, -1);
-            const Camera c = camera_for(tree, camera, size);
+            const Camera c = camera_for(tree, camera, size_of(size));
             Frame f;
             {
                 py::gil_scoped_release release;

@@ -223,9 +223,7 @@ RenderStats Renderer::render_tiles(const Camera& camera, std::span<const int> ti
 
 template <typename T>
 Frame render(const Octree<T>& tree, const Placement& placement, const Camera& camera, const RenderOptions& options) {
-    validate_options(options);
-    validate_camera(camera);
-    return Renderer(tree, placement, options).render(camera);
+    return Renderer(tree, placement, options).render(camera);   // options, then the camera, are checked there
 }
 
 #define OCTISO_INSTANTIATE(T)                                                                                       \
