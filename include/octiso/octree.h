@@ -16,6 +16,17 @@
 
 #include "octiso/volume.h"
 
+// Point location is forced inline: the traversal is compiled once per instruction set
+// (src/util/isa.h), and an out-of-line copy shared between those builds could run AVX2 code on a
+// CPU without it.
+#ifndef OCTISO_ALWAYS_INLINE
+#if defined(__GNUC__)
+#define OCTISO_ALWAYS_INLINE [[gnu::always_inline]] inline
+#else
+#define OCTISO_ALWAYS_INLINE inline
+#endif
+#endif
+
 namespace octiso {
 
 inline constexpr int kMaxDepth = 31;   ///< dmax <= 30 because extents are <= 2^30; one spare
@@ -38,12 +49,12 @@ template <typename T> struct InteriorNode {
     uint8_t child_mask;
     uint8_t reserved[3];
 
-    bool is_scalar_leaf(int c) const { return ((child_mask >> c) & 1u) == 0; }
-    uint32_t child_index(int c) const {
+    OCTISO_ALWAYS_INLINE bool is_scalar_leaf(int c) const { return ((child_mask >> c) & 1u) == 0; }
+    OCTISO_ALWAYS_INLINE uint32_t child_index(int c) const {
         return child_start + uint32_t(std::popcount(unsigned(child_mask) & ((1u << c) - 1u)));
     }
-    bool may_contain(int c, double iso) const { return double(min[c]) <= iso && iso <= double(max[c]); }
-    bool may_contain_any(int c, const double* isos, int count) const {
+    OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const { return double(min[c]) <= iso && iso <= double(max[c]); }
+    OCTISO_ALWAYS_INLINE bool may_contain_any(int c, const double* isos, int count) const {
         for (int i = 0; i < count; ++i)
             if (may_contain(c, isos[i])) return true;
         return false;
@@ -62,7 +73,7 @@ struct Coord {
 };
 
 /// Octant of `p` inside a node whose children have side `child_bit` (a power of two).
-inline int octant_of(Coord p, uint32_t child_bit) {
+OCTISO_ALWAYS_INLINE int octant_of(Coord p, uint32_t child_bit) {
     return ((p.x & child_bit) ? 4 : 0) | ((p.y & child_bit) ? 2 : 0) | ((p.z & child_bit) ? 1 : 0);
 }
 
@@ -105,7 +116,7 @@ public:
     /// Value of voxel p, starting the descent at node `index` of depth `depth` (a cap when depth
     /// == dmax-1). Precondition: p lies inside that node's cube. Knoll 2006 App. B.1, with the
     /// child octant built by bitwise or (the paper's `||` is a slip).
-    LeafRef<T> locate_from(Coord p, int depth, uint32_t index) const {
+    OCTISO_ALWAYS_INLINE LeafRef<T> locate_from(Coord p, int depth, uint32_t index) const {
         const int caps_at = a_.dmax - 1;
         for (;;) {
             if (depth == caps_at) return {a_.caps[index].voxel[octant_of(p, 1u)], depth, index, true};
@@ -123,12 +134,12 @@ public:
     /// `start`: parent_trace[d] is the node at depth d containing `start`, for d = 0 .. depth.
     /// Climbs to the deepest traced node whose cube also contains `dest`, then locates down
     /// (Knoll 2006 App. B.2; the paper's trailing root check is folded into the loop at d = 0).
-    T neighbour_find(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
+    OCTISO_ALWAYS_INLINE T neighbour_find(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
         return neighbour_locate(start, dest, depth, parent_trace).value;
     }
     /// The same, returning where the descent ended (the traversal then reads a whole forward
     /// neighbour block directly).
-    LeafRef<T> neighbour_locate(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
+    OCTISO_ALWAYS_INLINE LeafRef<T> neighbour_locate(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
         for (int d = depth; d > 0; --d) {
             const int shift = a_.dmax - d;   // cube side of a depth-d node is 2^shift
             if (((start.x ^ dest.x) >> shift) == 0 && ((start.y ^ dest.y) >> shift) == 0 &&

@@ -22,6 +22,16 @@
 
 namespace octiso {
 
+/// How primary rays traverse the octree: in packets of up to 8 neighbouring pixels that share
+/// node visits, culls and corner lookups (the default; Knoll, Wald, Hansen 2009), or one by one.
+/// Both give bit-identical frames; `single` exists for comparison and for the benchmark.
+enum class Traversal { packets, single };
+
+/// Which build of the traversal kernel runs: automatic (AVX2 + FMA where the CPU has them, else
+/// the portable x86-64-v2 build), or one forced (avx2 on a CPU without it is refused). All give
+/// bit-identical frames.
+enum class Isa { automatic, baseline, avx2 };
+
 struct RenderOptions {
     std::vector<double> isovalues;      ///< 1 .. kMaxIsovalues, each with its own colour
     RootFinder root_finder = RootFinder::neubauer;
@@ -30,6 +40,11 @@ struct RenderOptions {
     bool want_depth = false;
     bool want_normal = false;
     bool use_embree = true;             ///< false: call the traversal directly (no Embree dispatch)
+    Traversal traversal = Traversal::packets;
+    Isa isa = Isa::automatic;
+    /// Expert: a packet continues while at least this many lanes enter a subtree; 0 keeps the
+    /// measured default (OctreeTracer::kDefaultMinPacketLanes). For the benchmark's A/B.
+    int packet_min_lanes = 0;
     int threads = 0;                    ///< 0: all cores
     int tile_size = 0;                  ///< square tile side in pixels; 0: tile_size_for() picks it
 };

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "octiso/volume.h"
+#include "util/isa.h"
 
 namespace octiso {
 
@@ -27,12 +28,12 @@ struct IndexRay {
     /// t at which the ray crosses the plane p[axis] == plane; +inf ("never") when dir[axis] is
     /// +0 or -0, so no 0 * inf or 0/0 ever reaches a caller. A multiplication by the reciprocal,
     /// not a division: every tracer calls this one function, so all agree on each boundary t.
-    double plane_t(int axis, double plane) const {
+    OCTISO_ALWAYS_INLINE double plane_t(int axis, double plane) const {
         if (dir[axis] == 0) return std::numeric_limits<double>::infinity();
         return (plane - origin[axis]) * inv_dir[axis];
     }
 
-    static IndexRay make(const std::array<double, 3>& o, const std::array<double, 3>& d) {
+    OCTISO_ALWAYS_INLINE static IndexRay make(const std::array<double, 3>& o, const std::array<double, 3>& d) {
         IndexRay r;
         r.origin = o;
         r.set_direction(d);
@@ -41,7 +42,7 @@ struct IndexRay {
     /// A component whose reciprocal overflows (|d| < 2^-1024, subnormal) is flushed to +0: such a
     /// ray needs t > 1e300 to cross one cell, so it is parallel to that axis for every purpose, and
     /// flushing keeps 0 * inf (a NaN) out of plane_t.
-    void set_direction(const std::array<double, 3>& d) {
+    OCTISO_ALWAYS_INLINE void set_direction(const std::array<double, 3>& d) {
         dir = d;
         for (int a = 0; a < 3; ++a) {
             inv_dir[a] = d[a] == 0 ? 0.0 : 1.0 / d[a];
@@ -50,7 +51,7 @@ struct IndexRay {
     }
 };
 
-inline IndexRay index_from_world(const Ray& ray_world, const Placement& placement) {
+OCTISO_ALWAYS_INLINE IndexRay index_from_world(const Ray& ray_world, const Placement& placement) {
     IndexRay r;
     std::array<double, 3> d;
     for (int a = 0; a < 3; ++a) {
@@ -69,10 +70,10 @@ inline IndexRay index_from_world(const Ray& ray_world, const Placement& placemen
 struct BoxClip {
     double t_in = std::numeric_limits<double>::infinity();
     double t_out = -std::numeric_limits<double>::infinity();
-    bool empty() const { return !(t_in <= t_out); }
+    OCTISO_ALWAYS_INLINE bool empty() const { return !(t_in <= t_out); }
 };
 
-inline BoxClip clip_to_box(const IndexRay& ray, const std::array<double, 3>& box_hi, double t_min = 0.0) {
+OCTISO_ALWAYS_INLINE BoxClip clip_to_box(const IndexRay& ray, const std::array<double, 3>& box_hi, double t_min = 0.0) {
     BoxClip clip;
     double t_in = t_min, t_out = std::numeric_limits<double>::infinity();
     for (int a = 0; a < 3; ++a) {

@@ -12,8 +12,10 @@
 #include <limits>
 
 #include "math/ray.h"
+#include "util/isa.h"
 
 namespace octiso {
+OCTISO_ISA_BEGIN
 
 /// Unit cells: unit i spans the index planes [i, i + 1]. No multiply or divide in the loop.
 struct UnitCells {
@@ -86,4 +88,5 @@ inline bool walk_units(const IndexRay& r, const Units& units, const DdaBox& box,
     }
 }
 
+OCTISO_ISA_END
 }  // namespace octiso

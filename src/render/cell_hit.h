@@ -15,8 +15,10 @@
 #include "octiso/limits.h"
 #include "render/roots.h"
 #include "util/check.h"
+#include "util/isa.h"
 
 namespace octiso {
+OCTISO_ISA_BEGIN
 
 /// A coordinate that rounding left a hair off a cell face is put exactly on it, so that two
 /// cells sharing that face evaluate bitwise the same value there (cell.h) and the half-open
@@ -108,4 +110,5 @@ inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, Ray
     return true;
 }
 
+OCTISO_ISA_END
 }  // namespace octiso

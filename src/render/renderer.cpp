@@ -1,14 +1,14 @@
 // The persistent Renderer: per octree, the traversal set-up for the chosen scalar type and root
 // finder, the Embree device and scene (created once, re-pointed when options change) and the
 // thread arena; per frame, one primary ray per pixel through the one tile loop (tile_loop.h),
-// then shading and the AOVs. Policies (scalar type x root finder) are chosen once per frame by
-// a visit over the tracer variant, so the per-ray code is one inlined instantiation. What a
+// then shading and the AOVs. The traversal is a TracerKernel (tracer_kernel.h) built in
+// set_options for the scalar type, root finder and instruction set; the frame loop calls it once
+// per packet of up to 8 rays, through Embree or directly. What a
 // frame does not ask for is not computed: no normals unless colour or the normal AOV is wanted,
 // no shading without colour.
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <variant>
 
 #include <tbb/task_arena.h>
 
@@ -17,7 +17,7 @@
 #include "render/pinhole_camera.h"
 #include "render/shade.h"
 #include "render/tile_loop.h"
-#include "render/traverse.h"
+#include "render/tracer_kernel.h"
 #include "scene/embree_scene.h"
 
 namespace octiso {
@@ -62,15 +62,12 @@ struct Renderer::Impl {
 
 namespace {
 
-template <typename T> using TracerVariant =
-    std::variant<OctreeTracer<T, Neubauer>, OctreeTracer<T, Schwarze>, OctreeTracer<T, Linear>, OctreeTracer<T, Exact>>;
-
-/// Pixels of `rect` into `frame`: one run of up to kPacket pixels of a row per Embree call.
-template <class Tracer>
-void trace_rect(const Tracer& tracer, const EmbreeVolumeScene* scene, const PinholeCamera& pinhole,
+/// Pixels of `rect` into `frame`: one run of up to kPacket pixels of a row per kernel or Embree call.
+void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, const PinholeCamera& pinhole,
                 const RenderOptions& options, const PixelRect& rect, Frame& frame, TileCounters& counters) {
     constexpr int kPacket = EmbreeVolumeScene::kPacket;
     const bool want_normal = options.want_colour || options.want_normal;
+    const bool packets = options.traversal == Traversal::packets;
     const SrgbTable& to_srgb8 = SrgbTable::instance();
     const int W = frame.width;
     Ray rays[kPacket];
@@ -80,7 +77,8 @@ void trace_rect(const Tracer& tracer, const EmbreeVolumeScene* scene, const Pinh
             const int count = std::min(kPacket, rect.x1 - x0);
             for (int k = 0; k < count; ++k) rays[k] = pinhole.ray(x0 + k, py);
             if (scene) scene->intersect_packet(rays, count, want_normal, traced);
-            else for (int k = 0; k < count; ++k) traced[k] = tracer.trace(rays[k], want_normal);
+            else if (packets) kernel.trace_packet(kernel.user, rays, count, nullptr, want_normal, traced);
+            else for (int k = 0; k < count; ++k) traced[k] = kernel.trace(kernel.user, rays[k], want_normal);
             for (int k = 0; k < count; ++k) {
                 const TraceHit& hit = traced[k];
                 const size_t i = size_t(py) * W + size_t(x0 + k);
@@ -102,22 +100,19 @@ public:
 
     void set_options(const RenderOptions& o) override {
         adopt(o);
-        dispatch_root_finder(o.root_finder, o.iterations, [&](const auto& finder) {
-            using Tracer = OctreeTracer<T, std::decay_t<decltype(finder)>>;
-            const Tracer& tracer = tracer_.template emplace<Tracer>(tree_, placement_, o.isovalues.data(),
-                                                                    int(o.isovalues.size()), finder);
-            const EmbreeVolumeScene::TraceFn trace = [](const void* user, const Ray& ray, bool normal) {
-                return static_cast<const Tracer*>(user)->trace(ray, normal);
-            };
-            if (!o.use_embree) return;
+        // The scene points at the new kernel before the old one is dropped.
+        TracerKernel kernel = make_tracer_kernel(tree_, placement_, o, o.isa);
+        const EmbreeVolumeScene::TracePacketFn packet = o.traversal == Traversal::packets ? kernel.trace_packet : nullptr;
+        if (o.use_embree) {
             if (!scene_) {
                 scene_ = std::make_unique<EmbreeVolumeScene>();
-                scene_->add_volume(data_box_lo(), data_box_hi(), &tracer, trace);
+                scene_->add_volume(data_box_lo(), data_box_hi(), kernel.user, kernel.trace, packet);
                 scene_->commit();
             } else {
-                scene_->set_volume_trace(0, &tracer, trace);
+                scene_->set_volume_trace(0, kernel.user, kernel.trace, packet);
             }
-        });
+        }
+        kernel_ = std::move(kernel);
     }
 
     RenderStats render_tiles(const Camera& camera, std::span<const int> tiles, bool all, Frame& frame) const override {
@@ -125,13 +120,9 @@ public:
         const TileGrid grid = tile_grid_for(camera.width, camera.height, options.tile_size);
         const EmbreeVolumeScene* scene = options.use_embree ? scene_.get() : nullptr;
         return in_arena([&] {
-            return std::visit(
-                [&](const auto& tracer) {
-                    return for_each_tile(grid, tiles, all, [&](const PixelRect& rect, TileCounters& counters) {
-                        trace_rect(tracer, scene, pinhole, options, rect, frame, counters);
-                    });
-                },
-                tracer_);
+            return for_each_tile(grid, tiles, all, [&](const PixelRect& rect, TileCounters& counters) {
+                trace_rect(kernel_, scene, pinhole, options, rect, frame, counters);
+            });
         });
     }
 
@@ -152,9 +143,9 @@ private:
 
     const Octree<T> tree_;
     const Placement placement_;
-    // The tracer the scene's user geometry points at: it lives here, so its address is stable
-    // until the next set_options(), which re-points the scene.
-    TracerVariant<T> tracer_{std::in_place_index<0>, tree_, placement_, nullptr, 0, Neubauer{}};
+    // The kernel the scene's user geometry points at: it lives here, so its tracer's address is
+    // stable until the next set_options(), which re-points the scene.
+    TracerKernel kernel_;
     std::unique_ptr<EmbreeVolumeScene> scene_;
 };
 

@@ -11,8 +11,10 @@
 
 #include "octiso/root_finder.h"
 #include "render/cell.h"
+#include "util/isa.h"
 
 namespace octiso {
+OCTISO_ISA_BEGIN
 
 /// first_root's "no hit": negative, never NaN.
 inline constexpr double kNoHit = -1.0;
@@ -325,7 +327,9 @@ inline std::array<double, 3> world_normal(const double c[8], const std::array<do
     // 1. Scale the corners so that |c| <= 2^-2: differences stay <= 2^-1 and the lerps below
     //    (weights in [0,1], slightly outside for an extrapolated p_cell) cannot overflow.
     double big_c = 0;
-    for (int i = 0; i < 8; ++i) big_c = std::fmax(big_c, std::fabs(c[i]));
+    // std::max ignores a NaN second argument exactly as fmax does here (big_c starts at 0 and
+    // never becomes NaN), without fmax's library call.
+    for (int i = 0; i < 8; ++i) big_c = std::max(big_c, std::fabs(c[i]));
     if (!std::isfinite(big_c) || !(big_c > 0)) return fallback;
     int e = 0;
     std::frexp(big_c, &e);   // big_c < 2^e
@@ -338,7 +342,7 @@ inline std::array<double, 3> world_normal(const double c[8], const std::array<do
     for (double v : n)
         if (!std::isfinite(v)) return fallback;   // fmax below would hide a NaN component
     // 3. Scale by the largest component, so tiny values do not underflow in the squares.
-    const double big = std::fmax(std::fabs(n[0]), std::fmax(std::fabs(n[1]), std::fabs(n[2])));
+    const double big = std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])});   // finite: checked above
     if (!(big > 0)) return fallback;
     for (double& v : n) v /= big;
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
@@ -349,4 +353,5 @@ inline std::array<double, 3> world_normal(const double c[8], const std::array<do
     return n;
 }
 
+OCTISO_ISA_END
 }  // namespace octiso

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -32,8 +33,10 @@
 #include "math/ray.h"
 #include "render/roots.h"
 #include "util/check.h"
+#include "util/isa.h"
 
 namespace octiso {
+OCTISO_ISA_BEGIN
 
 /// The default corner source: the octree itself (in-cap reads and neighbour finding). Any other
 /// Corners type provides `void gather(Coord cell, double corner[8]) const` and replaces every
@@ -67,6 +70,46 @@ public:
         if constexpr (Recorder::kOn) recorder_.clip(clip.t_in, clip.t_out);
         if (!clip.empty()) node(w, 0, 0, Coord{}, clip.t_in, clip.t_out);
         return w.hit;
+    }
+
+    /// The most rays one trace_packet() call takes (one rtcIntersect8 packet, one row of 8 pixels).
+    static constexpr int kMaxPacket = 8;
+    /// A packet keeps traversing a subtree together while at least this many of its lanes enter
+    /// it; fewer lanes continue as single rays. Measured by `octiso-bench packets` (BENCHMARKS.md,
+    /// packet section): 2 was fastest of 1..4 on the MRI templates and plume at 512^2.
+    static constexpr int kDefaultMinPacketLanes = 4;
+    /// For the benchmark's A/B of the threshold and for tests that force one path; not thread-safe
+    /// against a frame in flight.
+    void set_min_packet_lanes(int lanes) { min_packet_lanes_ = std::max(1, lanes); }
+
+    /// First hits of rays[0 .. count), count <= kMaxPacket; lanes with valid[k] == 0 (valid may be
+    /// null: all valid) are misses. Every hit equals trace(rays[k]) bit for bit: each lane sees the
+    /// same child intervals, culls and cell walks as alone (see packet_node). Thread-safe.
+    void trace_packet(const Ray* rays, int count, const int* valid, bool want_normal, TraceHit* hits) const {
+        OCTISO_DCHECK(count >= 0 && count <= kMaxPacket, "packet of ", count);
+        Packet p;
+        unsigned by_flip[8] = {};
+        for (int k = 0; k < count; ++k) {
+            if (valid && !valid[k]) continue;
+            const BoxClip clip = p.lane[k].start(scene_, rays[k], want_normal);
+            if (clip.empty()) continue;
+            p.t0[k] = clip.t_in, p.t1[k] = clip.t_out;
+            const auto& dir = p.lane[k].ray.dir;
+            by_flip[(dir[0] < 0 ? 4 : 0) | (dir[1] < 0 ? 2 : 0) | (dir[2] < 0 ? 1 : 0)] |= 1u << k;
+        }
+        for (int flip = 0; flip < 8; ++flip) {
+            const unsigned lanes = by_flip[flip];
+            if (!lanes) continue;
+            if (std::popcount(lanes) < min_packet_lanes_) {
+                for (unsigned m = lanes; m; m &= m - 1) {
+                    const int k = std::countr_zero(m);
+                    node(p.lane[k], 0, 0, Coord{}, p.t0[k], p.t1[k]);
+                }
+            } else {
+                packet_node(p, 0, 0, Coord{}, lanes, flip, p.t0, p.t1);
+            }
+        }
+        for (int k = 0; k < count; ++k) hits[k] = p.lane[k].hit;
     }
 
 private:
@@ -125,9 +168,11 @@ private:
             if (t_next > t_cur && n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) {
                 const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
                 bool hit;
-                if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, d, co, half, n.scalar[c], t_cur, t_next);
-                else if (d == tree_.dmax() - 2) hit = cap(w, n.child_index(c), co, t_cur, t_next);
-                else hit = node(w, d + 1, n.child_index(c), co, t_cur, t_next);
+                if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
+                else if (d == tree_.dmax() - 2) {
+                    CapBlocks blocks;
+                    hit = cap(w, w.trace, n.child_index(c), co, t_cur, t_next, blocks);
+                } else hit = node(w, d + 1, n.child_index(c), co, t_cur, t_next);
                 if (hit) return true;
             }
             if (i == 3) break;
@@ -137,16 +182,113 @@ private:
         return false;
     }
 
-    bool cap(Walk& w, uint32_t cap_index, const Coord& co, double t0, double t1) const {
-        OCTISO_DCHECK(cap_index < tree_.cap_count(), "cap ", cap_index, " of ", tree_.cap_count());
-        if constexpr (Recorder::kOn) recorder_.enter_cap(tree_.dmax() - 1, cap_index, co, t0, t1);
-        w.trace[tree_.dmax() - 1] = cap_index;
-        const Cap<T>& cap = tree_.cap(cap_index);
-        // The forward neighbour blocks (2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), r = 1..7) are each a
-        // cap or lie inside one scalar leaf: located once per cap visit by neighbour finding, on
-        // first use, and then read directly for every corner and cell that falls in them.
+    /// The forward neighbour blocks of one cap (2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), r = 1..7):
+    /// each is a cap or lies inside one scalar leaf, located by neighbour finding on first use and
+    /// then read directly. One per cap visit; a packet shares it between its lanes.
+    struct CapBlocks {
         LeafRef<T> block[8];
         unsigned located = 0;
+    };
+
+    /// One packet of rays sharing their direction signs: per lane its walk, its piece [t0, t1) of
+    /// the data box; the parent trace is the packet's (all its lanes are in the same nodes).
+    struct Packet {
+        Walk lane[kMaxPacket];
+        double t0[kMaxPacket], t1[kMaxPacket];
+        uint32_t trace[kMaxDepth];
+    };
+
+    /// Knoll, Wald, Hansen 2009 for primary rays, exact: the lanes in `active` (all with the
+    /// direction signs `flip`, bit 4>>a set where dir[a] < 0) traverse node (d, index) together.
+    /// Children are visited in the order c = i ^ flip, i = 0..7: a ray with those signs only ever
+    /// moves to children with more bits of c ^ flip set, so this order is front to back for every
+    /// lane. Each child is culled once for the packet (the test is the same for every lane), and
+    /// a lane's interval in a child is exactly the single-ray one: its entry is the latest of t0
+    /// and the mid-plane times of the axes it has crossed to reach the child, its exit the
+    /// earliest of t1 and the times of the axes it has yet to cross; the pieces are the same
+    /// numbers node() splits at, so the first hit of every lane is the single-ray hit.
+    /// Returns the lanes of `active` that did not hit.
+    unsigned packet_node(Packet& p, int d, uint32_t index, const Coord& o, unsigned active, int flip,
+                         const double* t0, const double* t1) const {
+        OCTISO_DCHECK(d >= 0 && d <= tree_.dmax() - 2, "interior depth ", d, ", dmax ", tree_.dmax());
+        OCTISO_DCHECK(index < tree_.node_count(d), "node ", index, " of ", tree_.node_count(d), " at depth ", d);
+        p.trace[d] = index;
+        const InteriorNode<T>& n = tree_.node(d, index);
+        const uint32_t half = tree_.child_bit(d);
+        const uint32_t origin[3] = {o.x, o.y, o.z};
+        // Per lane, the children it crosses and its piece of each, by exactly node()'s arithmetic
+        // (mid-plane times, the sorting network, the running max); lanes_in[c]: who enters child c.
+        unsigned lanes_in[8] = {};
+        double c0[8][kMaxPacket], c1[8][kMaxPacket];
+        for (unsigned m = active; m; m &= m - 1) {
+            const int k = std::countr_zero(m);
+            const IndexRay& r = p.lane[k].ray;
+            double tm[3];
+            int c = 0;
+            for (int a = 0; a < 3; ++a) {
+                const double mid = double(origin[a] + half);
+                tm[a] = r.plane_t(a, mid);
+                if (upper_at(r, a, mid, tm[a], t0[k])) c |= 4 >> a;
+            }
+            int order[3] = {0, 1, 2};
+            if (tm[order[1]] < tm[order[0]]) std::swap(order[0], order[1]);
+            if (tm[order[2]] < tm[order[1]]) std::swap(order[1], order[2]);
+            if (tm[order[1]] < tm[order[0]]) std::swap(order[0], order[1]);
+            double t_cur = t0[k];
+            for (int i = 0; i <= 3; ++i) {
+                double t_next = t1[k];
+                if (i < 3 && tm[order[i]] > t0[k] && tm[order[i]] < t1[k]) t_next = tm[order[i]];
+                else if (i < 3) continue;
+                if (t_next > t_cur) {
+                    lanes_in[c] |= 1u << k;
+                    c0[c][k] = t_cur, c1[c][k] = t_next;
+                }
+                if (i == 3) break;
+                t_cur = std::max(t_cur, t_next);
+                c ^= 4 >> order[i];
+            }
+        }
+        for (int i = 0; i < 8 && active; ++i) {
+            const unsigned c = unsigned(i ^ flip);
+            const unsigned entered = lanes_in[c] & active;
+            if (!entered || !n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
+            const Coord co = child_origin_of(o, int(c), half);
+            unsigned hit = 0;
+            if (n.is_scalar_leaf(int(c))) {
+                for (unsigned m = entered; m; m &= m - 1) {
+                    const int k = std::countr_zero(m);
+                    if (scalar_leaf(p.lane[k], p.trace, d, co, half, n.scalar[c], c0[c][k], c1[c][k])) hit |= 1u << k;
+                }
+            } else if (d == tree_.dmax() - 2) {
+                CapBlocks blocks;   // located once for every lane that crosses this cap
+                const uint32_t ci = n.child_index(int(c));
+                for (unsigned m = entered; m; m &= m - 1) {
+                    const int k = std::countr_zero(m);
+                    if (cap(p.lane[k], p.trace, ci, co, c0[c][k], c1[c][k], blocks)) hit |= 1u << k;
+                }
+            } else if (std::popcount(entered) < min_packet_lanes_) {
+                for (unsigned m = entered; m; m &= m - 1) {
+                    const int k = std::countr_zero(m);
+                    Walk& w = p.lane[k];
+                    std::copy(p.trace, p.trace + d + 1, w.trace);
+                    if (node(w, d + 1, n.child_index(int(c)), co, c0[c][k], c1[c][k])) hit |= 1u << k;
+                }
+            } else {
+                hit = entered & ~packet_node(p, d + 1, n.child_index(int(c)), co, entered, flip, c0[c], c1[c]);
+            }
+            active &= ~hit;
+        }
+        return active;
+    }
+
+    bool cap(RayState& w, uint32_t* trace, uint32_t cap_index, const Coord& co, double t0, double t1,
+             CapBlocks& blocks) const {
+        OCTISO_DCHECK(cap_index < tree_.cap_count(), "cap ", cap_index, " of ", tree_.cap_count());
+        if constexpr (Recorder::kOn) recorder_.enter_cap(tree_.dmax() - 1, cap_index, co, t0, t1);
+        trace[tree_.dmax() - 1] = cap_index;
+        const Cap<T>& cap = tree_.cap(cap_index);
+        LeafRef<T>* block = blocks.block;
+        unsigned& located = blocks.located;
         return walk_cells(w, co, 2, t0, t1, [&](Coord v, double corner[8]) {
             if constexpr (!kOwnCorners) {
                 corners_.gather(v, corner);
@@ -162,7 +304,7 @@ private:
                 }
                 if (!((located >> r) & 1u)) {
                     const Coord b{co.x + ((r & 4) ? 2u : 0u), co.y + ((r & 2) ? 2u : 0u), co.z + ((r & 1) ? 2u : 0u)};
-                    block[r] = tree_.neighbour_locate(co, b, tree_.dmax() - 1, w.trace);
+                    block[r] = tree_.neighbour_locate(co, b, tree_.dmax() - 1, trace);
                     located |= 1u << r;
                 }
                 corner[k] = block[r].in_cap ? double(tree_.cap(block[r].index).voxel[(oct | dir) & ~r])
@@ -171,7 +313,8 @@ private:
         });
     }
 
-    bool scalar_leaf(Walk& w, int holder_depth, const Coord& co, uint32_t side, T value, double t0, double t1) const {
+    bool scalar_leaf(RayState& w, const uint32_t* trace, int holder_depth, const Coord& co, uint32_t side, T value,
+                     double t0, double t1) const {
         const double v = double(value);
         auto gather = [&](Coord p, double corner[8]) {
             if constexpr (!kOwnCorners) {
@@ -183,7 +326,7 @@ private:
                 const Coord dest{p.x + (k & 1), p.y + ((k >> 1) & 1), p.z + ((k >> 2) & 1)};
                 corner[k] = (dest.x < ex && dest.y < ey && dest.z < ez)
                                 ? v
-                                : double(tree_.neighbour_find(p, dest, holder_depth, w.trace));
+                                : double(tree_.neighbour_find(p, dest, holder_depth, trace));
             }
         };
         bool iso_equals_value = false;
@@ -215,7 +358,7 @@ private:
     /// the data exit); `gather` fills its 8 corners. Cells of the box beyond the data (padding)
     /// are stepped over. Returns true at the first hit.
     template <class Gather>
-    bool walk_cells(Walk& w, const Coord& lo, uint32_t side, double t0, double t1, Gather&& gather) const {
+    bool walk_cells(RayState& w, const Coord& lo, uint32_t side, double t0, double t1, Gather&& gather) const {
         const Dims dims = tree_.dims();
         const int64_t last_cell[3] = {int64_t(dims.x) - 2, int64_t(dims.y) - 2, int64_t(dims.z) - 2};
         const DdaBox box{{lo.x, lo.y, lo.z},
@@ -234,7 +377,7 @@ private:
                           });
     }
 
-    bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
+    bool test_cell(RayState& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
         if constexpr (Recorder::kOn) {
             double lo = corner[0], hi = corner[0];
             for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
@@ -249,8 +392,10 @@ private:
     const Octree<T> tree_;   // a view: cheap to copy, and no dangling reference to a temporary
     const CellWalkScene scene_;
     const Finder finder_;
+    int min_packet_lanes_ = kDefaultMinPacketLanes;
     [[no_unique_address]] const Corners corners_;
     [[no_unique_address]] const Recorder recorder_;
 };
 
+OCTISO_ISA_END
 }  // namespace octiso

@@ -25,6 +25,7 @@ struct VolumeGeometry {
     std::array<double, 3> lo, hi;
     const void* user;
     EmbreeVolumeScene::TraceFn trace;
+    EmbreeVolumeScene::TracePacketFn trace_packet;
 };
 
 void bounds_callback(const RTCBoundsFunctionArguments* args) {
@@ -49,9 +50,17 @@ void intersect_callback(const RTCIntersectFunctionNArguments* args) noexcept {
     const unsigned n = args->N;
     RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, n);
     RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, n);
-    for (unsigned i = 0; i < n && i < EmbreeVolumeScene::kPacket; ++i) {
+    const unsigned lanes = std::min(n, unsigned(EmbreeVolumeScene::kPacket));
+    TraceHit traced[EmbreeVolumeScene::kPacket];
+    if (g->trace_packet && lanes > 1) {
+        g->trace_packet(g->user, ctx->rays, int(lanes), args->valid, ctx->want_normal, traced);
+    } else {
+        for (unsigned i = 0; i < lanes; ++i)
+            if (args->valid[i]) traced[i] = g->trace(g->user, ctx->rays[i], ctx->want_normal);
+    }
+    for (unsigned i = 0; i < lanes; ++i) {
         if (!args->valid[i]) continue;
-        const TraceHit hit = g->trace(g->user, ctx->rays[i], ctx->want_normal);
+        const TraceHit& hit = traced[i];
         if (!hit.is_hit() || !(hit.t < ctx->hits[i].t)) continue;
         ctx->hits[i] = hit;
         RTCRayN_tfar(rays, n, i) = float(hit.t);
@@ -116,8 +125,8 @@ EmbreeVolumeScene::~EmbreeVolumeScene() {
 }
 
 void EmbreeVolumeScene::add_volume(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const void* user,
-                                   TraceFn trace) {
-    impl_->geometries.push_back(std::make_unique<VolumeGeometry>(VolumeGeometry{lo, hi, user, trace}));
+                                   TraceFn trace, TracePacketFn trace_packet) {
+    impl_->geometries.push_back(std::make_unique<VolumeGeometry>(VolumeGeometry{lo, hi, user, trace, trace_packet}));
     RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
     rtcSetGeometryUserPrimitiveCount(geom, 1);
     rtcSetGeometryUserData(geom, impl_->geometries.back().get());
@@ -129,10 +138,11 @@ void EmbreeVolumeScene::add_volume(const std::array<double, 3>& lo, const std::a
     rtcReleaseGeometry(geom);
 }
 
-void EmbreeVolumeScene::set_volume_trace(size_t index, const void* user, TraceFn trace) {
+void EmbreeVolumeScene::set_volume_trace(size_t index, const void* user, TraceFn trace, TracePacketFn trace_packet) {
     VolumeGeometry& g = *impl_->geometries.at(index);
     g.user = user;
     g.trace = trace;
+    g.trace_packet = trace_packet;
 }
 
 void EmbreeVolumeScene::commit() {

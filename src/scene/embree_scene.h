@@ -21,6 +21,10 @@ class EmbreeVolumeScene {
 public:
     /// A function that traces `ray` and returns the hit; `user` is the traced object.
     using TraceFn = TraceHit (*)(const void* user, const Ray& ray, bool want_normal);
+    /// Traces rays[0 .. count) at once (count <= kPacket; lanes with valid[k] == 0 are skipped)
+    /// into hits: Embree's intersectN callback hands its whole packet to it (issue 11).
+    using TracePacketFn = void (*)(const void* user, const Ray* rays, int count, const int* valid, bool want_normal,
+                                   TraceHit* hits);
 
     EmbreeVolumeScene();
     ~EmbreeVolumeScene();
@@ -28,10 +32,12 @@ public:
     EmbreeVolumeScene& operator=(const EmbreeVolumeScene&) = delete;
 
     /// Adds a volume whose world bounds are [lo, hi]; `user` must outlive the scene.
-    void add_volume(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const void* user, TraceFn trace);
+    /// `trace_packet` may be null (then each lane is traced alone).
+    void add_volume(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const void* user, TraceFn trace,
+                    TracePacketFn trace_packet = nullptr);
     /// Points volume `index` (in add_volume order) at another traced object; bounds stay. Not
     /// while a ray of this scene is in flight.
-    void set_volume_trace(size_t index, const void* user, TraceFn trace);
+    void set_volume_trace(size_t index, const void* user, TraceFn trace, TracePacketFn trace_packet = nullptr);
     void commit();
     /// First hit of `ray` (world, unit direction) over all geometries. Thread-safe after commit().
     TraceHit intersect(const Ray& ray, bool want_normal) const;

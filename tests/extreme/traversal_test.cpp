@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <random>
 #include <sstream>
@@ -158,6 +159,28 @@ Result run_rays(const DenseVolume<T>& v, const Octree<T>& tree, double iso, cons
               << ", reference " << (r.is_hit() ? "hit t=" : "miss") << (r.is_hit() ? r.t : 0.0) << " in cell ("
               << r.cell[0] << "," << r.cell[1] << "," << r.cell[2] << ")";
             res.first_mismatch = s.str();
+        }
+    }
+    // The same rays in packets of 8 (issue 11), once always as packets (threshold 1) and once with
+    // the default threshold: every lane must equal its single-ray hit bit for bit.
+    for (int lanes : {1, OctreeTracer<T, Exact>::kDefaultMinPacketLanes}) {
+        OctreeTracer<T, Exact> packed(tree, placement, &iso, 1, Exact{});
+        packed.set_min_packet_lanes(lanes);
+        for (size_t i0 = 0; i0 < rays.size(); i0 += 8) {
+            const int count = int(std::min<size_t>(8, rays.size() - i0));
+            Ray batch[8];
+            TraceHit hits[8];
+            for (int k = 0; k < count; ++k) batch[k] = rays[i0 + size_t(k)].ray;
+            packed.trace_packet(batch, count, nullptr, true, hits);
+            for (int k = 0; k < count; ++k) {
+                const TraceHit single = tracer.trace(batch[k], true);
+                if (!(single.iso_index == hits[k].iso_index && std::memcmp(&single.t, &hits[k].t, sizeof(double)) == 0 &&
+                      single.normal == hits[k].normal)) {
+                    ADD_FAILURE() << "packet lane " << k << " (threshold " << lanes
+                                  << ") differs from the single ray: " << describe(batch[k]);
+                    return res;
+                }
+            }
         }
     }
     return res;

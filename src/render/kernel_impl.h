@@ -1,0 +1,37 @@
+// The body of make_tracer_kernel_<isa> (tracer_kernel.h), included by exactly one translation
+// unit per instruction set: the OctreeTracer for the options' root finder, owned by the kernel,
+// and the two entry points the renderer and the Embree scene call. Everything this includes from
+// render/ lives in the ISA namespace of the including unit (util/isa.h).
+#pragma once
+
+#include <memory>
+
+#include "render/tracer_kernel.h"
+#include "render/traverse.h"
+
+namespace octiso {
+OCTISO_ISA_BEGIN
+
+template <typename T> TracerKernel build_tracer_kernel(const Octree<T>& tree, const Placement& placement,
+                                                       const RenderOptions& options, Isa isa) {
+    return dispatch_root_finder(options.root_finder, options.iterations, [&](const auto& finder) {
+        using Tracer = OctreeTracer<T, std::decay_t<decltype(finder)>>;
+        auto tracer = std::make_shared<Tracer>(tree, placement, options.isovalues.data(), int(options.isovalues.size()),
+                                               finder);
+        if (options.packet_min_lanes > 0) tracer->set_min_packet_lanes(options.packet_min_lanes);
+        TracerKernel k;
+        k.user = tracer.get();
+        k.tracer = std::move(tracer);
+        k.isa = isa;
+        k.trace = [](const void* user, const Ray& ray, bool normal) {
+            return static_cast<const Tracer*>(user)->trace(ray, normal);
+        };
+        k.trace_packet = [](const void* user, const Ray* rays, int count, const int* valid, bool normal, TraceHit* hits) {
+            static_cast<const Tracer*>(user)->trace_packet(rays, count, valid, normal, hits);
+        };
+        return k;
+    });
+}
+
+OCTISO_ISA_END
+}  // namespace octiso

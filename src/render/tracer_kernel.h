@@ -1,0 +1,45 @@
+// TracerKernel: the octree traversal for one (octree, isovalues, root finder), compiled for one
+// instruction set and chosen once per process (issue 11: runtime ISA dispatch). The portable
+// kernel (kernel_baseline.cpp, the default x86-64-v2 flags) and the AVX2 kernel (kernel_avx2.cpp,
+// -mavx2 -mfma -ffp-contract=off) are the same source (kernel_impl.h) in different ISA
+// namespaces (util/isa.h). FMA contraction is off, so both do the same IEEE operations in the
+// same order: frames are bit-identical across ISAs (tests/render/isa_test.cpp). The renderer only
+// sees function pointers, called once per packet of up to 8 rays, never per cell.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "octiso/octree.h"
+#include "octiso/render.h"
+#include "octiso/volume.h"
+#include "scene/embree_scene.h"
+
+namespace octiso {
+
+struct TracerKernel {
+    std::shared_ptr<const void> tracer;                 ///< owns the typed tracer `user` points at
+    const void* user = nullptr;
+    EmbreeVolumeScene::TraceFn trace = nullptr;               ///< one ray
+    EmbreeVolumeScene::TracePacketFn trace_packet = nullptr;  ///< up to 8 rays
+    Isa isa = Isa::baseline;
+};
+
+/// The instruction set `requested` resolves to on this CPU: automatic picks AVX2 where the CPU
+/// has AVX2 and FMA; an explicit avx2 on a CPU without them throws Error("isa", ...).
+Isa resolve_isa(Isa requested);
+/// Whether this CPU can run the AVX2 kernel.
+bool cpu_has_avx2();
+
+/// The kernel for `options` (isovalues, root finder, iterations, packet threshold) on `tree`,
+/// for the instruction set `isa` (resolved: baseline or avx2). The tree's storage must outlive it.
+template <typename T> TracerKernel make_tracer_kernel(const Octree<T>& tree, const Placement& placement,
+                                                      const RenderOptions& options, Isa isa);
+
+/// The two builds of the same source; make_tracer_kernel picks one.
+template <typename T> TracerKernel make_tracer_kernel_baseline(const Octree<T>& tree, const Placement& placement,
+                                                               const RenderOptions& options);
+template <typename T> TracerKernel make_tracer_kernel_avx2(const Octree<T>& tree, const Placement& placement,
+                                                           const RenderOptions& options);
+
+}  // namespace octiso
