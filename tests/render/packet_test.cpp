@@ -122,7 +122,9 @@ TEST(PacketTraversal, FramesIdenticalAcrossTraversalIsaAndEmbree) {
 }
 
 TEST(PacketTraversal, Avx2KernelRunsWhereTheCpuHasIt) {
-    if (!cpu_has_avx2()) OCTISO_SKIP("this CPU has no AVX2/FMA: only the portable kernel can run");
+    if (!cpu_has_avx2()) {
+        OCTISO_SKIP("this CPU has no AVX2/FMA: only the portable kernel can run");
+    }
     EXPECT_EQ(resolve_isa(Isa::automatic), Isa::avx2);
     EXPECT_EQ(resolve_isa(Isa::avx2), Isa::avx2);
     EXPECT_EQ(resolve_isa(Isa::baseline), Isa::baseline);
