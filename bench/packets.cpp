@@ -207,7 +207,8 @@ int run_packets(cli::Args& args) {
                                       const double s = threads == 1 ? thread_cpu_seconds() - c0 : f.stats.seconds;
                                       if (out) *out = std::move(f);
                                       return s;
-                                  }};
+                                  },
+                                  true, {}, true};
                 };
                 std::vector<Method> methods;
                 methods.push_back(octiso_method("octiso single, Embree", Traversal::single, Isa::baseline, true));
@@ -227,8 +228,8 @@ int run_packets(cli::Args& args) {
                                          s = threads == 1 ? thread_cpu_seconds() - c0 : wall;
                                      });
                                      return s;
-                                 }};
-                        m.octiso = false;
+                                 },
+                                 false, {}, true};
                         methods.push_back(m);
                     }
                 }

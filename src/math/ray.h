@@ -4,6 +4,7 @@
 // is divided by the spacing and NOT renormalised), so t is world distance along the unit ray.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -85,8 +86,10 @@ OCTISO_ALWAYS_INLINE BoxClip clip_to_box(const IndexRay& ray, const std::array<d
         }
         const double t_lo = ray.plane_t(a, d > 0 ? 0.0 : box_hi[a]);
         const double t_hi = ray.plane_t(a, d > 0 ? box_hi[a] : 0.0);
-        t_in = std::fmax(t_in, t_lo);
-        t_out = std::fmin(t_out, t_hi);
+        // Never NaN here (o and d are finite, plane_t of them is finite or never called with
+        // d == 0), where std::max/min equal fmax/fmin without their library calls.
+        t_in = std::max(t_in, t_lo);
+        t_out = std::min(t_out, t_hi);
     }
     if (!std::isfinite(t_in) || !std::isfinite(t_out) || !(t_in <= t_out)) return clip;   // dir == 0: no ray
     clip.t_in = t_in, clip.t_out = t_out;

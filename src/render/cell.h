@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 #include "util/isa.h"
 
 namespace octiso {
@@ -53,6 +54,20 @@ template <typename R> inline R scale_by_power_of_two(R x, int e) {
     return std::ldexp(x, e);
 }
 
+/// The exponent std::frexp would return for x > 0 (x = f * 2^e, f in [1/2, 1)), read from the bits
+/// when x is a normal double (frexp is a library call in the hot path), else frexp itself.
+template <typename R> inline int frexp_exponent(R x) {
+    if constexpr (std::is_same_v<R, double>) {
+        uint64_t bits;
+        std::memcpy(&bits, &x, sizeof bits);
+        const int biased = int((bits >> 52) & 0x7ff);
+        if (biased != 0 && biased != 0x7ff) return biased - 1022;
+    }
+    int e = 0;
+    std::frexp(x, &e);
+    return e;
+}
+
 /// f(s) = c[0] + c[1] s + c[2] s^2 + c[3] s^3 = (trilinear(p_in + s (p_out - p_in)) - iso) * 2^-scale_exp.
 /// Invariants: f_in == c[0] (direct trilinear at p_in) and f_out is the direct trilinear value at
 /// p_out under the same scaling, so the endpoint signs agree with the neighbouring cells (their
@@ -81,7 +96,7 @@ inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const st
     // a library call at x86-64-v2 (perf: fmax@plt + __fmax were 1.5 % of a frame on ch2better).
     for (int i = 0; i < 8; ++i) m = std::max(m, std::fabs(corner[i]));
     int e = 0;
-    if (m > 0) std::frexp(m, &e);
+    if (m > 0) e = frexp_exponent(m);
     R g[8];
     const R iso_scaled = R(scale_by_power_of_two(iso, -e));
     for (int i = 0; i < 8; ++i) g[i] = R(scale_by_power_of_two(corner[i], -e)) - iso_scaled;
@@ -107,7 +122,7 @@ inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const st
     R big = std::fabs(f.f_out);
     for (int i = 0; i < 4; ++i) big = std::max(big, std::fabs(f.c[i]));
     int e2 = 0;
-    if (big > 0) std::frexp(big, &e2);
+    if (big > 0) e2 = frexp_exponent(big);
     for (int i = 0; i < 4; ++i) f.c[i] = scale_by_power_of_two(f.c[i], -e2);
     f.f_out = scale_by_power_of_two(f.f_out, -e2);
     f.f_in = f.c[0];

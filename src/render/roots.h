@@ -331,10 +331,9 @@ inline std::array<double, 3> world_normal(const double c[8], const std::array<do
     // never becomes NaN), without fmax's library call.
     for (int i = 0; i < 8; ++i) big_c = std::max(big_c, std::fabs(c[i]));
     if (!std::isfinite(big_c) || !(big_c > 0)) return fallback;
-    int e = 0;
-    std::frexp(big_c, &e);   // big_c < 2^e
+    const int e = frexp_exponent(big_c);   // big_c < 2^e
     double cs[8];
-    for (int i = 0; i < 8; ++i) cs[i] = std::ldexp(c[i], -e - 2);
+    for (int i = 0; i < 8; ++i) cs[i] = scale_by_power_of_two(c[i], -e - 2);   // == std::ldexp, without the call
     const std::array<double, 3> g = gradient(cs, p_cell);
     // 2. Per world unit: g_a / s_a, up to the common factor 1/s_min, which the normalisation drops.
     const double s_min = std::fmin(spacing[0], std::fmin(spacing[1], spacing[2]));
