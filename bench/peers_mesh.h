@@ -19,7 +19,8 @@ enum class BvhQuality { medium, high };
 std::string bvh_quality_name(BvhQuality q);
 
 /// How the mesh's primary rays go to Embree.
-enum class MeshRays { single, packet8 };
+/// packet8: 8 pixels of a tile row per rtcIntersect8; packet8_block: 4x2 pixel blocks.
+enum class MeshRays { single, packet8, packet8_block };
 std::string mesh_rays_name(MeshRays r);
 
 struct MeshPeerOptions {

@@ -62,7 +62,12 @@ struct Renderer::Impl {
 
 namespace {
 
-/// Pixels of `rect` into `frame`: one run of up to kPacket pixels of a row per kernel or Embree call.
+/// Pixels of `rect` into `frame`, one packet of up to kPacket pixels per kernel or Embree call:
+/// blocks of kPacketW x kPacketH pixels, whose rays stay closer together than a row's (more lanes
+/// share each node and cap; BENCHMARKS.md, packets: 4x2 against 8x1).
+constexpr int kPacketW = 4, kPacketH = 2;
+static_assert(kPacketW * kPacketH == EmbreeVolumeScene::kPacket);
+
 void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, const PinholeCamera& pinhole,
                 const RenderOptions& options, const PixelRect& rect, Frame& frame, TileCounters& counters) {
     constexpr int kPacket = EmbreeVolumeScene::kPacket;
@@ -72,16 +77,21 @@ void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, cons
     const int W = frame.width;
     Ray rays[kPacket];
     TraceHit traced[kPacket];
-    for (int py = rect.y0; py < rect.y1; ++py)
-        for (int x0 = rect.x0; x0 < rect.x1; x0 += kPacket) {
-            const int count = std::min(kPacket, rect.x1 - x0);
-            for (int k = 0; k < count; ++k) rays[k] = pinhole.ray(x0 + k, py);
+    size_t pixel[kPacket];
+    for (int y0 = rect.y0; y0 < rect.y1; y0 += kPacketH)
+        for (int x0 = rect.x0; x0 < rect.x1; x0 += kPacketW) {
+            int count = 0;
+            for (int py = y0; py < std::min(y0 + kPacketH, rect.y1); ++py)
+                for (int px = x0; px < std::min(x0 + kPacketW, rect.x1); ++px) {
+                    rays[count] = pinhole.ray(px, py);
+                    pixel[count++] = size_t(py) * W + size_t(px);
+                }
             if (scene) scene->intersect_packet(rays, count, want_normal, traced);
             else if (packets) kernel.trace_packet(kernel.user, rays, count, nullptr, want_normal, traced);
             else for (int k = 0; k < count; ++k) traced[k] = kernel.trace(kernel.user, rays[k], want_normal);
             for (int k = 0; k < count; ++k) {
                 const TraceHit& hit = traced[k];
-                const size_t i = size_t(py) * W + size_t(x0 + k);
+                const size_t i = pixel[k];
                 counters.hits += hit.is_hit();
                 if (options.want_depth) frame.depth[i] = float(hit.t);
                 if (options.want_normal)

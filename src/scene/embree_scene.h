@@ -1,6 +1,6 @@
 // EmbreeVolumeScene: an Embree 3 scene with one user geometry per volume, whose bounds are the
 // volume's data box in world space and whose intersect callback runs the octree traversal.
-// Primary rays go through rtcIntersect8 (packets along tile rows) or rtcIntersect1. Embree's RTCRay holds floats, so the exact double ray
+// Primary rays go through rtcIntersect8 (packets of 4x2 pixels) or rtcIntersect1. Embree's RTCRay holds floats, so the exact double ray
 // travels beside it in an extended intersect context; the callback traces that one, and the
 // Embree and direct paths return bit-identical hits.
 #pragma once
