@@ -1,22 +1,19 @@
-// What the tools' text reports share: numbers printed as people write them (shortest form that
-// reads back to the same double, never "-500.000000"), and the world box of a placed grid.
+// What the tools' text reports share: numbers printed as people write them ({fmt}'s shortest form
+// that reads back to the same double, never "-500.000000"), and the world box of a placed grid.
 #pragma once
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <string>
+
+#include <fmt/format.h>
 
 #include "octiso/volume.h"
 
 namespace octiso::cli {
 
 /// The shortest decimal text that parses back to `v` exactly ("0.5", "-500", "1e-07").
-inline std::string number(double v) {
-    char buf[64];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);
-    return std::string(buf, r.ptr);
-}
+inline std::string number(double v) { return fmt::format("{}", v); }
 
 /// "X, Y, Z" with number() for each component.
 inline std::string numbers(const std::array<double, 3>& v) { return number(v[0]) + ", " + number(v[1]) + ", " + number(v[2]); }
