@@ -24,6 +24,7 @@
 #include "octiso/oct_file.h"
 #include "octiso/output_guard.h"
 #include "octiso/value_stats.h"
+#include "octiso/volume_writer.h"
 #include "octiso/verify.h"
 
 namespace {
@@ -42,12 +43,15 @@ constexpr const char* kUsage =
     "  --bins N                  histogram bins, 1..4096 (default 16)\n"
     "  --verify                  recompute every min/max and scalar from the leaves (exit 2 on a lie)\n"
     "  --extract-raw OUT.raw     write one step back as a raw x-fastest array, byte for byte\n"
-    "  --step K                  the step --extract-raw writes (default 0)\n"
-    "  --endian little|big       byte order of --extract-raw (default little)\n"
+    "  --extract OUT.vti|.nrrd|.raw   the same with a header VTK, ParaView, 3D Slicer read (type,\n"
+    "                            dims, spacing, origin); .raw as --extract-raw\n"
+    "  --step K                  the step --extract(-raw) writes (default 0)\n"
+    "  --endian little|big       byte order of raw output (default little)\n"
     "  --version, -h/--help\n";
 
 struct Extract {
     std::string path;
+    bool with_header = false;   ///< --extract OUT.vti/.nrrd: a format that carries dims and placement
     uint32_t step = 0;
     bool big_endian = false;
     uint64_t bytes = 0;
@@ -66,6 +70,12 @@ void extract_raw(const std::shared_ptr<const OctFile>& file, Extract& ex) {
                                          std::to_string(memory) + " bytes of memory");
     const AnyOctree step = AnyOctree::step(file, ex.step);
     std::vector<std::byte> data(size_t(ex.bytes));
+    if (ex.with_header) {   // the formats' own byte order declaration: native
+        step.decode(data, std::endian::native);
+        file->check_unchanged();
+        write_volume_file(ex.path, info.type, info.dims, info.placement, data);
+        return;
+    }
     step.decode(data, ex.big_endian ? std::endian::big : std::endian::little);
     file->check_unchanged();   // issue 18: the decoded data came from what was validated
     write_file_atomically(ex.path, data.data(), ex.bytes);   // every write, fsync and close checked
@@ -241,7 +251,11 @@ int main(int argc, char** argv) {
         const bool json = args.flag("--json");
         const bool help = args.flag("--help") || args.flag("-h");
         const bool verify = args.flag("--verify");
-        const std::optional<std::string> extract_path = args.value("--extract-raw");
+        const std::optional<std::string> extract_raw_path = args.value("--extract-raw");
+        const std::optional<std::string> extract_any_path = args.value("--extract");
+        if (extract_raw_path && extract_any_path) throw Error("--extract", "give --extract or --extract-raw, not both");
+        const std::optional<std::string> extract_path = extract_raw_path ? extract_raw_path : extract_any_path;
+        const char* extract_flag = extract_raw_path ? "--extract-raw" : "--extract";
         const std::optional<std::string> step_text = args.value("--step");
         const std::optional<std::string> endian_text = args.value("--endian");
         const std::optional<std::string> bins_text = args.value("--bins");
@@ -258,13 +272,17 @@ int main(int argc, char** argv) {
         if (files.size() != 1)
             throw Error("", std::string(files.empty() ? "no input file" : "more than one input file") + " (octiso-info --help lists every flag)");
         if ((step_text || endian_text) && !extract_path)
-            throw Error(step_text ? "--step" : "--endian", "only makes sense with --extract-raw");
+            throw Error(step_text ? "--step" : "--endian", "only makes sense with --extract or --extract-raw");
         const int bins = bins_text ? int(cli::parse_int(*bins_text, "--bins", 1, 4096)) : 16;
-        if (extract_path) refuse_output_onto_input(*extract_path, files, "--extract-raw");   // issue 18
-        if (extract_path) cli::check_output_file(*extract_path, "--extract-raw");
+        if (extract_path) refuse_output_onto_input(*extract_path, files, extract_flag);   // issue 18
+        if (extract_any_path && !is_volume_file_format(*extract_any_path))
+            throw Error("--extract", "'" + *extract_any_path + "': expected a .vti, .nrrd or .raw name");
+        if (extract_path) cli::check_output_file(*extract_path, extract_flag);
         Extract ex;
         if (extract_path) {
             ex.path = *extract_path;
+            ex.with_header = extract_any_path && !(extract_any_path->size() >= 4 && extract_any_path->substr(extract_any_path->size() - 4) == ".raw");
+            if (ex.with_header && endian_text) throw Error("--endian", "applies to raw output only (.vti and .nrrd declare their byte order)");
             if (step_text) ex.step = uint32_t(cli::parse_int(*step_text, "--step", 0, UINT32_MAX));
             if (endian_text) {
                 if (*endian_text != "little" && *endian_text != "big")
