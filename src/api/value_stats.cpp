@@ -3,12 +3,14 @@
 // with the number of data voxels of its cube, a cap voxel by voxel. Percentiles are exact by
 // refinement: each pass histograms the interval that still holds the wanted rank into kSubBins
 // bins and narrows it to the [min, max] of the values in the bin holding the rank, until that
-// interval holds a single value (an integer type needs at most 3 passes, floats a few more).
+// interval holds a single value (32-bit integers need at most 3 passes, floats a few more).
+// Types of 16 bits or fewer are counted value by value in one walk instead.
 #include "octiso/value_stats.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "octiso/error.h"
 
@@ -75,7 +77,43 @@ struct Target {
     bool done = false;
 };
 
+/// Types of at most 16 bits: one walk counts every value exactly (65536 counters at most), and
+/// range, percentiles and histogram are read from the counts. The walk does one add per voxel
+/// instead of a bin per percentile target: octiso-info on ch2better (u8, 35 M voxels) went from
+/// 1.1-1.5 s to 0.07 s with the same figures.
+template <typename T> ValueStats stats_by_counting(const Octree<T>& tree, int bins) {
+    constexpr int64_t lowest = int64_t(std::numeric_limits<T>::lowest());
+    std::vector<uint64_t> count(size_t(int64_t(std::numeric_limits<T>::max()) - lowest + 1), 0);
+    walk(tree, [&](T v, uint64_t n) { count[size_t(int64_t(v) - lowest)] += n; });
+    ValueStats s;
+    s.counts.assign(size_t(bins), 0);
+    size_t first = count.size(), last = 0;
+    for (size_t i = 0; i < count.size(); ++i)
+        if (count[i]) {
+            first = std::min(first, i), last = i;
+            s.voxels += count[i];
+        }
+    if (s.voxels == 0) return s;
+    s.range = {double(int64_t(first) + lowest), double(int64_t(last) + lowest)};
+    std::array<uint64_t, ValueStats::percentile_levels.size()> rank{};
+    for (size_t i = 0; i < rank.size(); ++i) {
+        const double want = std::ceil(ValueStats::percentile_levels[i] / 100.0 * double(s.voxels));
+        rank[i] = std::clamp<uint64_t>(uint64_t(want), 1, s.voxels);
+    }
+    uint64_t below = 0;
+    size_t next = 0;
+    for (size_t i = first; i <= last; ++i) {
+        if (!count[i]) continue;
+        const double v = double(int64_t(i) + lowest);
+        s.counts[size_t(s.bin_of(v))] += count[i];
+        below += count[i];
+        while (next < rank.size() && below >= rank[next]) s.percentiles[next++] = v;
+    }
+    return s;
+}
+
 template <typename T> ValueStats stats_of(const Octree<T>& tree, int bins) {
+    if constexpr (std::is_integral_v<T> && sizeof(T) <= 2) return stats_by_counting(tree, bins);
     ValueStats s;
     // 1. Range and counts.
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
