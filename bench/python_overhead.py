@@ -61,7 +61,7 @@ def main():
         frame_py_wall.append(time.perf_counter() - t0)
         frame_py_loop.append(frame.seconds)
         out = subprocess.run([tool("octiso-render"), oct_path, "--iso", "100.5", "--size", "512x512", "--eye", eye, "--look",
-                              look, "--up", "0,0,1", "--fov", str(camera.fov), "-o", os.path.join(work, "f.png"), "--json"],
+                              look, "--up", "0,0,1", "--fov", str(camera.fov), "--shading", "headlight", "-o", os.path.join(work, "f.png"), "--json"],
                              check=True, capture_output=True, text=True)
         frame_cli.append(json.loads(out.stdout)["frames"][0]["seconds"])
 

@@ -8,6 +8,9 @@
 
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
+#include "cli/common/output_path.h"
+#include "cli/common/report.h"
+#include "octiso/any_octree.h"
 #include "octiso/build.h"
 #include "octiso/convert.h"
 #include "octiso/error.h"
@@ -19,17 +22,34 @@ namespace {
 using namespace octiso;
 
 constexpr const char* kUsage =
-    "usage: octiso-convert INPUT -o OUT.oct [--dims NX,NY,NZ --type T [--endian little|big] [--offset BYTES]]\n"
-    "                      [--spacing SX,SY,SZ] [--origin OX,OY,OZ] [--iso-range LO,HI] [--tolerance EPS]\n"
-    "                      [--nan-as V] [--threads N] [--json]\n"
+    "usage: octiso-convert INPUT -o OUT.oct [options]\n"
     "       octiso-convert --synthetic NAME:N|NAME:NX,NY,NZ [--type T] -o OUT.oct [options]\n"
     "       octiso-convert --synthetic plume-series:N,STEPS -o SERIES.oct [options]\n"
     "       octiso-convert --synthetic sparse-spheres:N -o OUT.oct [--json]   (N^3 virtual, e.g. 16384)\n"
     "       octiso-convert --steps A:B 'pattern_%03d.raw' -o SERIES.oct [options]\n"
     "       octiso-convert STEP0 STEP1 ... -o SERIES.oct [options]   (a time series, one step per INPUT)\n"
-    "INPUT: .nii .nii.gz .vti .vtk .mhd .mha .nrrd .nhdr, or raw (needs --dims and --type)\n"
-    "NAME: sphere marschner-lobb sponge noise plume mixing plume-series\n"
-    "T: u8 i8 u16 i16 u32 i32 f32 f64";
+    "\n"
+    "A volume (or a time series of them) into one lossless .oct file. The report prints the range of\n"
+    "values stored (a wrong --type or --endian shows there at once) and the size against the input.\n"
+    "\n"
+    "INPUT: .nii .nii.gz .vti .vtk .mhd .mha .nrrd .nhdr (placement from the header), or raw\n"
+    "  -o, --output OUT.oct      the file to write (temporary + rename: never a partial file)\n"
+    "  --dims NX,NY,NZ           raw input: grid size, x fastest (required for raw)\n"
+    "  --type T                  raw input: u8 i8 u16 i16 u32 i32 f32 f64 (required for raw);\n"
+    "                            --synthetic: the stored type (default: the dataset's own)\n"
+    "  --endian little|big       raw input: byte order (default little)\n"
+    "  --offset BYTES            raw input: header bytes to skip (default 0)\n"
+    "  --spacing SX,SY,SZ        world size of a voxel step (default 1,1,1 or the header's)\n"
+    "  --origin OX,OY,OZ         world position of voxel 0,0,0 (default 0,0,0 or the header's)\n"
+    "  --iso-range LO,HI         clamp what cannot reach (LO, HI): smaller, exact for isovalues inside\n"
+    "                            (default: none, every isovalue exact)\n"
+    "  --tolerance EPS           merge siblings within EPS: lossy, error <= EPS (default 0, lossless)\n"
+    "  --nan-as V                replace NaN and +-inf by V (default: refuse non-finite input)\n"
+    "  --steps A:B               a series from a printf pattern, steps A..B inclusive\n"
+    "  --synthetic NAME:N        sphere marschner-lobb sponge noise plume mixing plume-series sparse-spheres\n"
+    "  --threads N               worker threads, 0 = all cores (default 0)\n"
+    "  --json                    one JSON object on stdout; the text report goes to stderr\n"
+    "  --version, -h/--help\n";
 
 std::string dims_text(Dims d) {
     return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
@@ -96,7 +116,18 @@ ConvertSource parse_source(cli::Args& args) {
     return ConvertSource::files(positional, raw);
 }
 
-void write_json(std::ostream& os, const ConvertReport& r) {
+/// The range of values the file stores: the union of its steps' root min/max (what octiso-render
+/// accepts as isovalues), read back from the finished file so that it reports what was written.
+std::optional<std::array<double, 2>> stored_range(const std::string& path) {
+    const auto file = std::make_shared<const OctFile>(OctFile::open(path, Verify::IndicesOnly));
+    std::optional<std::array<double, 2>> r;
+    for (uint32_t k = 0; k < file->info().step_count; ++k)
+        if (const auto v = AnyOctree::step(file, k).info().value_range)
+            r = r ? std::array<double, 2>{std::min((*r)[0], (*v)[0]), std::max((*r)[1], (*v)[1])} : *v;
+    return r;
+}
+
+void write_json(std::ostream& os, const ConvertReport& r, const std::optional<std::array<double, 2>>& range) {
     const Dims d = r.dims;
     const StepSizes& tot = r.total;
     cli::JsonWriter j(os);
@@ -107,7 +138,11 @@ void write_json(std::ostream& os, const ConvertReport& r) {
     j.key("spacing").array(r.placement.spacing).key("origin").array(r.placement.origin);
     j.field("steps", r.steps).field("dmax", r.dmax);
     j.field("input_bytes", r.input_bytes).field("file_bytes", r.file_bytes);
-    j.field("ratio", r.ratio());
+    j.field("ratio", r.ratio());   // file / raw input
+    j.field("larger_than_input", r.file_bytes > r.input_bytes);
+    j.key("value_range");
+    if (range) j.array(*range);
+    else j.null();
     j.key("split").begin_object();
     j.field("interior_bytes", tot.interior_bytes).field("minmax_bytes", tot.minmax_bytes).field("cap_bytes", tot.cap_bytes);
     j.end_object();
@@ -130,13 +165,15 @@ void write_json(std::ostream& os, const ConvertReport& r) {
     os << "\n";
 }
 
-void write_human(std::ostream& os, const ConvertReport& r) {
+void write_human(std::ostream& os, const ConvertReport& r, const std::optional<std::array<double, 2>>& range) {
     const StepSizes& tot = r.total;
     os << "octiso-convert: " << r.input << " (" << volume_format_name(r.format) << ", " << scalar_type_name(r.type) << " "
        << dims_text(r.dims) << (r.steps > 1 ? ", " + std::to_string(r.steps) + " steps" : "") << ", "
        << mib(r.input_bytes) << ") -> " << r.output << "\n";
+    os << "  values " << (range ? cli::number((*range)[0]) + " .. " + cli::number((*range)[1]) : std::string("none (no cell)"))
+       << (r.steps > 1 ? " over all steps" : "") << " (the isovalues octiso-render accepts)\n";
     os << std::fixed << std::setprecision(3);
-    os << "  file " << mib(r.file_bytes) << ", ratio " << r.ratio() << "; interior " << mib(tot.interior_bytes)
+    os << "  file " << mib(r.file_bytes) << ", ratio " << r.ratio() << " (file / raw); interior " << mib(tot.interior_bytes)
        << " (min/max " << mib(tot.minmax_bytes) << "), caps " << mib(tot.cap_bytes) << "\n";
     os << "  depth       nodes  scalar leaves\n";
     for (size_t k = 0; k < tot.nodes_per_depth.size(); ++k)
@@ -145,6 +182,10 @@ void write_human(std::ostream& os, const ConvertReport& r) {
            << (int(k) == r.dmax - 1 ? "  (caps)" : "") << "\n";
     os << "  build " << r.build_seconds << " s (" << r.mvoxels_per_second() << " Mvoxel/s, " << r.threads
        << " threads), total " << r.total_seconds << " s, peak RSS " << mib(r.peak_rss_bytes) << "\n";
+    if (r.file_bytes > r.input_bytes)
+        os << "  note: the octree is larger than its input (" << mib(r.file_bytes) << " > " << mib(r.input_bytes)
+           << "): too little of the data is uniform to merge. --iso-range LO,HI (exact for every isovalue inside it)"
+              " or --tolerance EPS (lossy, error <= EPS) makes it smaller\n";
 }
 
 /// --synthetic sparse-spheres:N (f32, N^3, N >= 64): built directly as an octree, no dense array
@@ -155,6 +196,7 @@ int convert_sparse_spheres(cli::Args& args, uint32_t n) {
     args.value("--synthetic");
     args.finish();
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
+    cli::check_output_file(*out, "-o");   // before the work, naming the user's path
     const ConvertReport r = octiso::convert(ConvertSource::sparse_spheres(n), *out, BuildOptions{});
     std::cerr << "octiso-convert: " << r.input << " (f32 " << dims_text(r.dims) << ", built directly as an octree) -> "
               << r.output << ", " << mib(r.file_bytes) << ", " << r.total_seconds << " s\n";
@@ -173,11 +215,11 @@ int convert_sparse_spheres(cli::Args& args, uint32_t n) {
 int run(std::vector<std::string>& argv) {
     cli::Args args(argv);
     if (args.flag("--help") || args.flag("-h")) {
-        std::cerr << kUsage << "\n";
+        std::cout << kUsage;
         return 0;
     }
-    if (argv.empty()) {
-        std::cerr << kUsage << "\n";
+    if (argv.empty()) {   // the same in every tool: the help, as a usage error
+        std::cerr << kUsage;
         return 2;
     }
     for (size_t i = 0; i + 1 < argv.size(); ++i)   // sparse-spheres never makes a dense array
@@ -192,14 +234,16 @@ int run(std::vector<std::string>& argv) {
         if (opt.tolerance < 0) throw Error("--tolerance", "must be >= 0, found '" + *t + "'");
     }
     if (const auto v = args.value("--nan-as")) opt.nan_as = cli::parse_double(*v, "--nan-as");
-    if (const auto t = args.value("--threads")) opt.threads = int(cli::parse_int(*t, "--threads", 1, 4096));
+    if (const auto t = args.value("--threads")) opt.threads = int(cli::parse_int(*t, "--threads", 0, 4096));   // 0: all cores
     const ConvertSource src = parse_source(args);
     args.finish();
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
+    cli::check_output_file(*out, "-o");   // before the work, naming the user's path
 
     const ConvertReport report = octiso::convert(src, *out, opt);
-    write_human(std::cerr, report);
-    if (json) write_json(std::cout, report);
+    const auto range = stored_range(report.output);
+    write_human(std::cerr, report, range);
+    if (json) write_json(std::cout, report, range);
     return 0;
 }
 

@@ -20,6 +20,9 @@ void write_normal_image(const std::string& path, const Frame& frame);
 /// Checks before rendering that OpenImageIO can write `path` (known extension), so a long render
 /// never ends in an unwritable file. Throws Error(flag, ...).
 void check_image_path(const std::string& path, const std::string& flag);
+/// Whether the format of `path` (by extension) stores float channels (EXR, TIFF, HDR, FITS, PFM):
+/// the formats a depth image keeps its distances in. Throws Error(path, ...) for an unknown format.
+bool image_format_holds_floats(const std::string& path);
 
 /// A float image read back (tests, comparisons): width x height x channels, row 0 at the top.
 struct FloatImage {

@@ -1,6 +1,8 @@
 // octiso-info: what a .oct file holds (header, sizes per step, counts per depth) and, with
 // --extract-raw, the data of one step back as a raw array (CONVENTIONS 3). Every step is fully
-// validated (checksums and indices) before it is reported.
+// validated (checksums and indices) before it is reported. The value figures (range, exact
+// percentiles, histogram) come from the tree (value_stats.h), so a wrong --type or --endian at
+// conversion shows at once.
 #include <cerrno>
 #include <cstdio>
 #include <unistd.h>
@@ -13,12 +15,16 @@
 
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
+#include "cli/common/output_path.h"
+#include "cli/common/report.h"
 #include "format/oct_layout.h"
 #include "util/atomic_output.h"
 #include "octiso/any_octree.h"
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
 #include "octiso/output_guard.h"
+#include "octiso/value_stats.h"
+#include "octiso/volume_writer.h"
 #include "octiso/verify.h"
 
 namespace {
@@ -26,10 +32,26 @@ namespace {
 using namespace octiso;
 
 constexpr const char* kUsage =
-    "usage: octiso-info FILE.oct [--json] [--verify] [--extract-raw OUT.raw [--step K] [--endian little|big]]";
+    "usage: octiso-info FILE.oct [options]\n"
+    "\n"
+    "What a .oct file holds: type, dims, placement (world box of the voxel positions and its centre),\n"
+    "the data range (exact, the root's min/max: the isovalues octiso-render accepts), sizes, and per\n"
+    "step the nodes and scalar leaves per depth, the exact voxel min/max, percentiles and a histogram\n"
+    "(read from the tree, no dense array). Every step is validated (checksums and indices) first.\n"
+    "\n"
+    "  --json                    one JSON object on stdout; the text report goes to stderr\n"
+    "  --bins N                  histogram bins, 1..4096 (default 16)\n"
+    "  --verify                  recompute every min/max and scalar from the leaves (exit 2 on a lie)\n"
+    "  --extract-raw OUT.raw     write one step back as a raw x-fastest array, byte for byte\n"
+    "  --extract OUT.vti|.nrrd|.raw   the same with a header VTK, ParaView, 3D Slicer read (type,\n"
+    "                            dims, spacing, origin); .raw as --extract-raw\n"
+    "  --step K                  the step --extract(-raw) writes (default 0)\n"
+    "  --endian little|big       byte order of raw output (default little)\n"
+    "  --version, -h/--help\n";
 
 struct Extract {
     std::string path;
+    bool with_header = false;   ///< --extract OUT.vti/.nrrd: a format that carries dims and placement
     uint32_t step = 0;
     bool big_endian = false;
     uint64_t bytes = 0;
@@ -48,6 +70,12 @@ void extract_raw(const std::shared_ptr<const OctFile>& file, Extract& ex) {
                                          std::to_string(memory) + " bytes of memory");
     const AnyOctree step = AnyOctree::step(file, ex.step);
     std::vector<std::byte> data(size_t(ex.bytes));
+    if (ex.with_header) {   // the formats' own byte order declaration: native
+        step.decode(data, std::endian::native);
+        file->check_unchanged();
+        write_volume_file(ex.path, info.type, info.dims, info.placement, data);
+        return;
+    }
     step.decode(data, ex.big_endian ? std::endian::big : std::endian::little);
     file->check_unchanged();   // issue 18: the decoded data came from what was validated
     write_file_atomically(ex.path, data.data(), ex.bytes);   // every write, fsync and close checked
@@ -62,8 +90,42 @@ std::string join(const std::vector<uint64_t>& v) {
     return s;
 }
 
-void human_report(std::ostream& os, const OctFile& file, const std::vector<StepSizes>& steps, const Extract* ex) {
+/// What one step's values are: the root's range (what the renderer checks isovalues against) and
+/// the statistics walked from the tree.
+struct StepValues {
+    std::optional<std::array<double, 2>> root_range;
+    ValueStats stats;
+};
+
+/// The union of the steps' root ranges: the isovalues octiso-render accepts for this file.
+std::optional<std::array<double, 2>> file_range(const std::vector<StepValues>& values) {
+    std::optional<std::array<double, 2>> r;
+    for (const StepValues& v : values)
+        if (v.root_range) r = r ? std::array<double, 2>{std::min((*r)[0], (*v.root_range)[0]), std::max((*r)[1], (*v.root_range)[1])}
+                                : *v.root_range;
+    return r;
+}
+
+void human_values(std::ostream& os, const StepValues& v) {
+    const ValueStats& s = v.stats;
+    os << "    values                   ";
+    if (s.voxels == 0) os << "none finite";
+    else os << "min " << cli::number(s.range[0]) << ", max " << cli::number(s.range[1]) << " over " << s.voxels << " voxels";
+    if (s.non_finite) os << " (" << s.non_finite << " NaN or infinite)";
+    os << "\n";
+    if (s.voxels == 0) return;
+    os << "    percentiles              ";
+    for (size_t i = 0; i < s.percentiles.size(); ++i)
+        os << (i ? "  " : "") << cli::number(ValueStats::percentile_levels[i]) << "%: " << cli::number(s.percentiles[i]);
+    os << "\n    histogram (" << s.counts.size() << " bins from " << cli::number(s.bin_edge(0)) << " to "
+       << cli::number(s.bin_edge(int(s.counts.size()))) << ")  " << join(s.counts) << "\n";
+}
+
+void human_report(std::ostream& os, const OctFile& file, const std::vector<StepSizes>& steps,
+                  const std::vector<StepValues>& values, const Extract* ex) {
     const OctInfo& in = file.info();
+    const cli::WorldBox box = cli::world_box(in.dims, in.placement);
+    const auto range = file_range(values);
     const uint64_t raw = checked_volume_bytes(in.dims, in.type, file.path()) * in.step_count;
     os << std::setprecision(10);
     os << file.path() << ": .oct format version " << format::kFormatVersion << ", header "
@@ -74,6 +136,12 @@ void human_report(std::ostream& os, const OctFile& file, const std::vector<StepS
        << in.placement.spacing[2] << "\n";
     os << "  origin      " << in.placement.origin[0] << ", " << in.placement.origin[1] << ", "
        << in.placement.origin[2] << "\n";
+    os << "  world box   " << cli::numbers(box.lo) << " .. " << cli::numbers(box.hi) << " (voxel positions)\n";
+    os << "  centre      " << cli::numbers(box.centre) << "\n";
+    os << "  data range  ";
+    if (range) os << cli::number((*range)[0]) << " .. " << cli::number((*range)[1]) << " (exact, the root's min/max"
+                  << (in.step_count > 1 ? " over all steps" : "") << "; isovalues outside it draw nothing)\n";
+    else os << "none (no cell: an extent is 1)\n";
     os << "  dmax        " << in.dmax << " (cube side " << (uint64_t(1) << in.dmax) << ")\n";
     os << "  iso-range   ";
     if (in.iso_range) os << (*in.iso_range)[0] << ", " << (*in.iso_range)[1] << "\n";
@@ -83,7 +151,7 @@ void human_report(std::ostream& os, const OctFile& file, const std::vector<StepS
     os << "  file bytes  " << file.file_bytes() << "\n";
     os << "  raw bytes   " << raw << " (dims x " << scalar_type_bytes(in.type) << " bytes x " << in.step_count
        << " steps)\n";
-    os << "  ratio       " << std::setprecision(4) << double(raw) / double(file.file_bytes()) << " : 1 (raw / file)\n"
+    os << "  ratio       " << std::setprecision(4) << double(file.file_bytes()) / double(raw) << " (file / raw)\n"
        << std::setprecision(10);
     for (size_t k = 0; k < steps.size(); ++k) {
         const StepSizes& s = steps[k];
@@ -91,14 +159,18 @@ void human_report(std::ostream& os, const OctFile& file, const std::vector<StepS
            << "), caps " << s.cap_bytes << " bytes\n";
         os << "    nodes per depth          " << join(s.nodes_per_depth) << "  (last: caps)\n";
         os << "    scalar leaves per depth  " << join(s.scalar_leaves_per_depth) << "\n";
+        human_values(os, values[k]);
     }
     if (ex)
         os << "  extracted step " << ex->step << " to " << ex->path << " (" << ex->bytes << " bytes, "
            << (ex->big_endian ? "big" : "little") << "-endian)\n";
 }
 
-void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSizes>& steps, const Extract* ex) {
+void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSizes>& steps,
+                 const std::vector<StepValues>& values, const Extract* ex) {
     const OctInfo& in = file.info();
+    const cli::WorldBox box = cli::world_box(in.dims, in.placement);
+    const auto range = file_range(values);
     const uint64_t raw_step = checked_volume_bytes(in.dims, in.type, file.path());
     const uint64_t raw = raw_step * in.step_count;
     cli::JsonWriter j(os);
@@ -110,6 +182,11 @@ void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSi
     j.key("dims").begin_array().value(in.dims.x).value(in.dims.y).value(in.dims.z).end_array();
     j.key("spacing").array(in.placement.spacing);
     j.key("origin").array(in.placement.origin);
+    j.key("world_box").begin_object().key("min").array(box.lo).key("max").array(box.hi).end_object();
+    j.key("centre").array(box.centre);
+    j.key("value_range");
+    if (range) j.array(*range);
+    else j.null();
     j.field("dmax", in.dmax);
     j.key("iso_range");
     if (in.iso_range) j.array(*in.iso_range);
@@ -119,7 +196,7 @@ void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSi
     j.field("file_bytes", file.file_bytes());
     j.field("raw_bytes_per_step", raw_step);
     j.field("raw_bytes", raw);
-    j.field("ratio", double(raw) / double(file.file_bytes()));
+    j.field("ratio", double(file.file_bytes()) / double(raw));   // file / raw, as octiso-convert
     j.key("per_step").begin_array();
     for (size_t k = 0; k < steps.size(); ++k) {
         const StepSizes& s = steps[k];
@@ -130,6 +207,27 @@ void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSi
         j.field("cap_bytes", s.cap_bytes);
         j.key("nodes_per_depth").array(s.nodes_per_depth);
         j.key("scalar_leaves_per_depth").array(s.scalar_leaves_per_depth);
+        const StepValues& v = values[k];
+        j.key("value_range");
+        if (v.root_range) j.array(*v.root_range);
+        else j.null();
+        j.field("voxels", v.stats.voxels).field("non_finite_voxels", v.stats.non_finite);
+        j.key("min");
+        if (v.stats.voxels) j.value(v.stats.range[0]);
+        else j.null();
+        j.key("max");
+        if (v.stats.voxels) j.value(v.stats.range[1]);
+        else j.null();
+        j.key("percentiles").begin_object();
+        for (size_t i = 0; i < v.stats.percentiles.size(); ++i) {
+            j.key("p" + cli::number(ValueStats::percentile_levels[i]));
+            if (v.stats.voxels) j.value(v.stats.percentiles[i]);
+            else j.null();
+        }
+        j.end_object();
+        j.key("histogram").begin_object().key("edges").begin_array();
+        for (int b = 0; b <= int(v.stats.counts.size()); ++b) j.value(v.stats.bin_edge(b));
+        j.end_array().key("counts").array(v.stats.counts).end_object();
         j.end_object();
     }
     j.end_array();
@@ -153,23 +251,38 @@ int main(int argc, char** argv) {
         const bool json = args.flag("--json");
         const bool help = args.flag("--help") || args.flag("-h");
         const bool verify = args.flag("--verify");
-        const std::optional<std::string> extract_path = args.value("--extract-raw");
+        const std::optional<std::string> extract_raw_path = args.value("--extract-raw");
+        const std::optional<std::string> extract_any_path = args.value("--extract");
+        if (extract_raw_path && extract_any_path) throw Error("--extract", "give --extract or --extract-raw, not both");
+        const std::optional<std::string> extract_path = extract_raw_path ? extract_raw_path : extract_any_path;
+        const char* extract_flag = extract_raw_path ? "--extract-raw" : "--extract";
         const std::optional<std::string> step_text = args.value("--step");
         const std::optional<std::string> endian_text = args.value("--endian");
+        const std::optional<std::string> bins_text = args.value("--bins");
         const std::vector<std::string> files = args.positional();
         args.finish();
         if (help) {
-            std::cout << kUsage << "\n";
+            std::cout << kUsage;
             return 0;
         }
+        if (argv_rest.empty()) {   // the same in every tool: the help, as a usage error
+            std::cerr << kUsage;
+            return 2;
+        }
         if (files.size() != 1)
-            throw Error("", std::string(files.empty() ? "no input file" : "more than one input file") + "; " + kUsage);
+            throw Error("", std::string(files.empty() ? "no input file" : "more than one input file") + " (octiso-info --help lists every flag)");
         if ((step_text || endian_text) && !extract_path)
-            throw Error(step_text ? "--step" : "--endian", "only makes sense with --extract-raw");
-        if (extract_path) refuse_output_onto_input(*extract_path, files, "--extract-raw");   // issue 18
+            throw Error(step_text ? "--step" : "--endian", "only makes sense with --extract or --extract-raw");
+        const int bins = bins_text ? int(cli::parse_int(*bins_text, "--bins", 1, 4096)) : 16;
+        if (extract_path) refuse_output_onto_input(*extract_path, files, extract_flag);   // issue 18
+        if (extract_any_path && !is_volume_file_format(*extract_any_path))
+            throw Error("--extract", "'" + *extract_any_path + "': expected a .vti, .nrrd or .raw name");
+        if (extract_path) cli::check_output_file(*extract_path, extract_flag);
         Extract ex;
         if (extract_path) {
             ex.path = *extract_path;
+            ex.with_header = extract_any_path && !(extract_any_path->size() >= 4 && extract_any_path->substr(extract_any_path->size() - 4) == ".raw");
+            if (ex.with_header && endian_text) throw Error("--endian", "applies to raw output only (.vti and .nrrd declare their byte order)");
             if (step_text) ex.step = uint32_t(cli::parse_int(*step_text, "--step", 0, UINT32_MAX));
             if (endian_text) {
                 if (*endian_text != "little" && *endian_text != "big")
@@ -185,7 +298,12 @@ int main(int argc, char** argv) {
                                       " (expected 0 .. " + std::to_string(file.info().step_count - 1) + ")");
         std::vector<StepSizes> steps;
         steps.reserve(file.info().step_count);
-        for (uint32_t k = 0; k < file.info().step_count; ++k) steps.push_back(file.step_sizes(k));
+        std::vector<StepValues> values;
+        for (uint32_t k = 0; k < file.info().step_count; ++k) {
+            steps.push_back(file.step_sizes(k));
+            const AnyOctree step = AnyOctree::step(shared_file, k);
+            values.push_back({step.info().value_range, value_stats(step, bins)});
+        }
         if (verify) {   // issue 18: every min/max and scalar recomputed from the leaves; a lie exits 2
             const VerifyStats v = verify_octree(file);
             (json ? std::cerr : std::cout) << files[0] << ": verified " << v.nodes << " interior nodes, " << v.ranges
@@ -195,10 +313,10 @@ int main(int argc, char** argv) {
 
         const Extract* exp = extract_path ? &ex : nullptr;
         if (json) {
-            human_report(std::cerr, file, steps, exp);
-            json_report(std::cout, file, steps, exp);
+            human_report(std::cerr, file, steps, values, exp);
+            json_report(std::cout, file, steps, values, exp);
         } else {
-            human_report(std::cout, file, steps, exp);
+            human_report(std::cout, file, steps, values, exp);
         }
         return 0;
     });

@@ -57,6 +57,8 @@ void check_image_path(const std::string& path, const std::string& flag) {
     if (!OIIO::ImageOutput::create(path)) throw Error(flag, "'" + path + "': no image format for this extension");
 }
 
+bool image_format_holds_floats(const std::string& path) { return float_or_native(path) == OIIO::TypeDesc::FLOAT; }
+
 void write_colour_image(const std::string& path, const Frame& frame) {
     if (frame.rgb.empty()) throw Error(path, "the frame has no colour image", ErrorKind::Other);
     write_image(path, frame.width, frame.height, 3, OIIO::TypeDesc::UINT8, frame.rgb.data(), {"R", "G", "B"},

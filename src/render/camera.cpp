@@ -1,4 +1,5 @@
-// The default framing of a data box and the camera checks of CONVENTIONS 2.
+// The default framing of a data box, the orbit and the named axis views around it, and the
+// camera checks of CONVENTIONS 2.
 #include <algorithm>
 #include <cmath>
 
@@ -13,7 +14,8 @@ namespace {
 /// The camera looking at the data box's centre from unit direction `view` (centre -> eye), z up,
 /// far enough that the box's bounding sphere fits the narrower of the two fields of view, divided
 /// by `zoom`.
-Camera camera_towards_box(Dims dims, const Placement& placement, int width, int height, const Vec3& view, double zoom) {
+Camera camera_towards_box(Dims dims, const Placement& placement, int width, int height, const Vec3& view, double zoom,
+                          const Vec3& up = {0, 0, 1}) {
     std::array<double, 3> lo, hi, centre;
     double radius2 = 0;
     for (int a = 0; a < 3; ++a) {
@@ -34,7 +36,7 @@ Camera camera_towards_box(Dims dims, const Placement& placement, int width, int 
     const double distance = radius / std::sin(narrow) * 1.02 / zoom;
     for (int a = 0; a < 3; ++a) c.eye[a] = centre[a] + view[a] * distance;
     c.look = centre;
-    c.up = {0, 0, 1};
+    c.up = up;
     return c;
 }
 
@@ -55,6 +57,33 @@ Camera orbit_camera(Dims dims, const Placement& placement, int width, int height
     return camera_towards_box(dims, placement, width, height, view, zoom);
 }
 
+namespace {
+constexpr std::string_view kAxisViewNames[] = {"front", "back", "left", "right", "top", "bottom", "iso"};
+}
+
+std::optional<AxisView> parse_axis_view(std::string_view name) {
+    for (int i = 0; i < 7; ++i)
+        if (name == kAxisViewNames[i]) return AxisView(i);
+    return std::nullopt;
+}
+
+std::string_view axis_view_name(AxisView view) { return kAxisViewNames[int(view)]; }
+
+Camera axis_view_camera(Dims dims, const Placement& placement, int width, int height, AxisView view, double zoom) {
+    if (!(zoom > 0) || !std::isfinite(zoom)) throw Error("--zoom", "must be a positive number");
+    // Each vector points from the centre to the eye.
+    switch (view) {
+        case AxisView::front: return camera_towards_box(dims, placement, width, height, {0, -1, 0}, zoom);
+        case AxisView::back: return camera_towards_box(dims, placement, width, height, {0, 1, 0}, zoom);
+        case AxisView::left: return camera_towards_box(dims, placement, width, height, {-1, 0, 0}, zoom);
+        case AxisView::right: return camera_towards_box(dims, placement, width, height, {1, 0, 0}, zoom);
+        case AxisView::top: return camera_towards_box(dims, placement, width, height, {0, 0, 1}, zoom, {0, 1, 0});
+        case AxisView::bottom: return camera_towards_box(dims, placement, width, height, {0, 0, -1}, zoom, {0, 1, 0});
+        case AxisView::iso: break;
+    }
+    return camera_towards_box(dims, placement, width, height, vec_normalized({0.9, -1.3, 0.8}), zoom);
+}
+
 void validate_camera(const Camera& camera) {
     if (camera.width < 1 || camera.height < 1) throw Error("--size", "width and height must be positive");
     if (!(camera.fov_deg > 0 && camera.fov_deg < 180)) throw Error("--fov", "must lie in (0, 180) degrees");
@@ -63,6 +92,8 @@ void validate_camera(const Camera& camera) {
     const Vec3 side = vec_cross(f, camera.up);
     if (!(vec_dot(side, side) > 1e-24 * vec_dot(f, f) * std::max(vec_dot(camera.up, camera.up), 1e-300)))
         throw Error("--up", "must not be parallel to the viewing direction (or zero)");
+    for (const double d : camera.pixel_offset)
+        if (!(std::fabs(d) <= 1.0)) throw Error("--spp", "a pixel offset must lie within [-1, 1] pixels");
 }
 
 }  // namespace octiso

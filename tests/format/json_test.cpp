@@ -1,5 +1,5 @@
 // cli::JsonWriter (src/cli/common/json.h), the writer behind every --json report: commas and
-// nesting, string escaping, and non-finite numbers as null.
+// nesting, string escaping (nlohmann-json's), and non-finite numbers as null, finite ones shortest.
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -27,9 +27,10 @@ TEST(JsonWriter, EscapesStrings) {
     EXPECT_EQ(JsonWriter::escape("plain"), "plain");
     EXPECT_EQ(JsonWriter::escape("a\"b\\c"), "a\\\"b\\\\c");
     EXPECT_EQ(JsonWriter::escape("\n\t\r\b\f"), "\\n\\t\\r\\b\\f");
-    EXPECT_EQ(JsonWriter::escape(std::string("\x01\x1f\x7f", 3)), "\\u0001\\u001f\\u007f");
+    EXPECT_EQ(JsonWriter::escape(std::string("\x01\x1f\x7f", 3)), "\\u0001\\u001f\x7f");   // DEL needs no escape (RFC 8259)
     EXPECT_EQ(JsonWriter::escape(std::string("nul\0x", 5)), "nul\\u0000x");
     EXPECT_EQ(JsonWriter::escape("\xc3\xa9"), "\xc3\xa9");   // UTF-8 passes through
+    EXPECT_EQ(JsonWriter::escape("a\xff" "b"), "a\xef\xbf\xbd" "b");   // invalid UTF-8: U+FFFD, the output stays JSON
     std::ostringstream os;
     JsonWriter(os).key("k\"ey").value("v\nal");
     EXPECT_EQ(os.str(), "\"k\\\"ey\":\"v\\nal\"");
@@ -53,6 +54,13 @@ TEST(JsonWriter, NonFiniteNumbersAreNullAndFiniteOnesRoundTrip) {
     in >> a >> comma >> b;
     EXPECT_EQ(a, 0.1);
     EXPECT_EQ(b, -2.5e-300);
+    EXPECT_EQ(s.substr(16), "0.1,-2.5e-300]") << "the shortest text that round-trips";
+}
+
+TEST(JsonWriter, IntegralDoublesAreWrittenAsIntegers) {
+    std::ostringstream os;
+    JsonWriter(os).begin_array().value(7.0).value(-1.5).value(-500.0).value(1e300).value(-0.0).end_array();
+    EXPECT_EQ(os.str(), "[7,-1.5,-500,1e+300,-0.0]");
 }
 
 }  // namespace

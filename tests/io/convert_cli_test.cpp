@@ -185,7 +185,7 @@ TEST_F(ConvertCli, BadInputExitsTwoAndLeavesNothing) {
         raw + " -o " + out + " --dims 3,4,5 --type u8 --offset 61",
         raw + " -o " + out + " --dims 3,4,5 --type u8 --endian middle",
         raw + " -o " + out + " --dims 3,4,5 --type u8 --bogus",    // unknown flag
-        raw + " -o " + out + " --dims 3,4,5 --type u8 --threads 0",
+        raw + " -o " + out + " --dims 3,4,5 --type u8 --threads -1",   // 0 means all cores
         raw + " -o " + out + " --dims 3,4,5 --type u8 --spacing 1,0,1",
         raw + " --dims 3,4,5 --type u8",                           // no -o
         dir.file("missing.raw") + " -o " + out + " --dims 3,4,5 --type u8",

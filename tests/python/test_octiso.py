@@ -86,8 +86,9 @@ def test_render_equals_the_tool(tmp_path):
     path = str(tmp_path / "v.oct")
     octiso.build(a).save(path)
     png = str(tmp_path / "tool.png")
+    # The Renderer's own colour is the tool's --shading headlight (the tool's default is the light kit).
     cmd = [os.path.join(TOOLS, "octiso-render"), path, "--iso", "60.5", "--size", "96x72", "-o", png,
-           "--eye", "60,-40,50", "--look", "21,17,19", "--up", "0,0,1", "--fov", "45"]
+           "--eye", "60,-40,50", "--look", "21,17,19", "--up", "0,0,1", "--fov", "45", "--shading", "headlight"]
     subprocess.run(cmd, check=True, capture_output=True)
     tree = octiso.open(path).step(0)
     camera = octiso.Camera(eye=(60, -40, 50), look=(21, 17, 19), up=(0, 0, 1), fov=45)
@@ -96,7 +97,8 @@ def test_render_equals_the_tool(tmp_path):
     assert frame.hits > 1000
     assert np.array_equal(frame.rgb, read_png(png))
     # The default framing is the tool's default framing too.
-    subprocess.run([os.path.join(TOOLS, "octiso-render"), path, "--iso", "60.5", "--size", "64x48", "-o", png],
+    subprocess.run([os.path.join(TOOLS, "octiso-render"), path, "--iso", "60.5", "--size", "64x48", "-o", png,
+                    "--shading", "headlight"],
                    check=True, capture_output=True)
     assert np.array_equal(tree.render(60.5, size=(64, 48)).rgb, read_png(png))
 

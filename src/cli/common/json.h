@@ -1,6 +1,9 @@
 // JsonWriter: the tiny streaming writer behind every --json report (CONVENTIONS 3: exactly one
-// JSON object on stdout). It tracks commas and nesting, escapes strings per RFC 8259, and writes
-// non-finite numbers as null, which JSON cannot express otherwise.
+// JSON object on stdout). It tracks commas and nesting; every string and number is encoded by
+// nlohmann-json (RFC 8259 escaping, invalid UTF-8 replaced by U+FFFD instead of passed through,
+// the shortest decimal that reads back to the same double), and non-finite numbers are null,
+// which JSON cannot express otherwise. Streaming stays ours: reports are written as they are
+// computed, and a fragment (a key and its value) can be written on its own.
 #pragma once
 
 #include <cmath>
@@ -11,6 +14,8 @@
 #include <string_view>
 #include <type_traits>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 namespace octiso::cli {
 
@@ -51,21 +56,21 @@ public:
         out_ << "null";
         return *this;
     }
-    /// Integers exactly; floating point with 17 significant digits (round-trips), NaN/Inf as null.
+    /// Integers exactly; floating point as the shortest text that round-trips, NaN/Inf as null.
     template <typename N, std::enable_if_t<std::is_arithmetic_v<N> && !std::is_same_v<N, bool>, int> = 0>
     JsonWriter& value(N v) {
         separate();
         if constexpr (std::is_integral_v<N>) {
-            if constexpr (std::is_signed_v<N>) out_ << static_cast<long long>(v);
-            else out_ << static_cast<unsigned long long>(v);
+            if constexpr (std::is_signed_v<N>) out_ << nlohmann::json(static_cast<long long>(v)).dump();
+            else out_ << nlohmann::json(static_cast<unsigned long long>(v)).dump();
         } else {
-            if (!std::isfinite(double(v))) {
-                out_ << "null";
-            } else {
-                char buf[32];
-                std::snprintf(buf, sizeof buf, "%.17g", double(v));
-                out_ << buf;
-            }
+            // An integral value is written without nlohmann's ".0" ("7", as every report wrote it
+            // before; below 2^53 the integer is the double exactly). nlohmann writes NaN, +-inf as null.
+            const double d = static_cast<double>(v);
+            if (d == std::trunc(d) && std::fabs(d) < 9007199254740992.0 && !(d == 0 && std::signbit(d)))
+                out_ << nlohmann::json(static_cast<long long>(d)).dump();
+            else
+                out_ << nlohmann::json(d).dump();
         }
         return *this;
     }
@@ -78,31 +83,11 @@ public:
         return end_array();
     }
 
-    /// Escapes `s` as the body of a JSON string (no quotes): ", \, and control characters.
+    /// Escapes `s` as the body of a JSON string (no quotes): ", \, control characters; invalid
+    /// UTF-8 becomes U+FFFD.
     static std::string escape(std::string_view s) {
-        std::string r;
-        r.reserve(s.size());
-        for (const char ch : s) {
-            const unsigned char c = static_cast<unsigned char>(ch);
-            switch (c) {
-                case '"': r += "\\\""; break;
-                case '\\': r += "\\\\"; break;
-                case '\b': r += "\\b"; break;
-                case '\f': r += "\\f"; break;
-                case '\n': r += "\\n"; break;
-                case '\r': r += "\\r"; break;
-                case '\t': r += "\\t"; break;
-                default:
-                    if (c < 0x20 || c == 0x7f) {
-                        char buf[8];
-                        std::snprintf(buf, sizeof buf, "\\u%04x", c);
-                        r += buf;
-                    } else {
-                        r += ch;   // UTF-8 bytes pass through unchanged
-                    }
-            }
-        }
-        return r;
+        const std::string quoted = nlohmann::json(std::string(s)).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+        return quoted.substr(1, quoted.size() - 2);
     }
 
 private:

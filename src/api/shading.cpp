@@ -1,0 +1,129 @@
+// shade_frame (include/octiso/shading.h): per hit pixel, the isovalue it shows (read back from
+// the field when there are several), its albedo, and the light model; misses get the background.
+#include "octiso/shading.h"
+
+#include <charconv>
+#include <cmath>
+
+#include "math/vec.h"
+#include "octiso/error.h"
+#include "render/light_kit.h"
+#include "render/pinhole_camera.h"
+#include "render/shade.h"
+
+namespace octiso {
+
+namespace {
+
+/// The trilinear interpolant at world point `p` (CONVENTIONS 1), clamped into the data's cells.
+template <typename T> double field_at(const Octree<T>& tree, const Placement& placement, const Vec3& p) {
+    const uint32_t n[3] = {tree.dims().x, tree.dims().y, tree.dims().z};
+    uint32_t lo[3], hi[3];
+    double f[3];
+    for (int a = 0; a < 3; ++a) {
+        const double q = (p[a] - placement.origin[a]) / placement.spacing[a];
+        const double top = double(n[a] > 1 ? n[a] - 2 : 0);
+        const double cell = std::isfinite(q) ? std::clamp(std::floor(q), 0.0, top) : 0.0;
+        lo[a] = uint32_t(cell);
+        hi[a] = n[a] > 1 ? lo[a] + 1 : lo[a];
+        f[a] = n[a] > 1 && std::isfinite(q) ? std::clamp(q - cell, 0.0, 1.0) : 0.0;
+    }
+    double v = 0;
+    for (int c = 0; c < 8; ++c) {
+        const Coord at{(c & 4) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 1) ? hi[2] : lo[2]};
+        const double w = ((c & 4) ? f[0] : 1 - f[0]) * ((c & 2) ? f[1] : 1 - f[1]) * ((c & 1) ? f[2] : 1 - f[2]);
+        v += w * double(tree.point_locate(at));
+    }
+    return v;
+}
+
+/// Index of the isovalue nearest to v.
+int nearest_isovalue(double v, const std::vector<double>& isovalues) {
+    int best = 0;
+    for (int i = 1; i < int(isovalues.size()); ++i)
+        if (std::fabs(v - isovalues[size_t(i)]) < std::fabs(v - isovalues[size_t(best)])) best = i;
+    return best;
+}
+
+float linear_from_srgb(double s) { return float(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4)); }
+
+}  // namespace
+
+void shade_frame(const AnyOctree& tree, const std::vector<double>& isovalues, const Camera& camera, const Shading& shading,
+                 Frame& frame) {
+    const size_t pixels = size_t(frame.width) * size_t(frame.height);
+    if (frame.depth.size() != pixels || frame.normal.size() != 3 * pixels)
+        throw Error("shade_frame", "needs the depth and normal AOVs of the frame", ErrorKind::Other);
+    frame.rgb.resize(3 * pixels);
+    const PinholeCamera pinhole(camera);
+    CameraFrame cam;
+    cam.forward = vec_normalized(vec_sub(camera.look, camera.eye));
+    cam.right = vec_normalized(vec_cross(cam.forward, camera.up));
+    cam.up = vec_cross(cam.right, cam.forward);
+    const LightKit kit;
+    const std::array<Vec3, kKitLights> to_light = light_directions(kit, cam);
+    const SrgbTable& to_srgb8 = SrgbTable::instance();
+    dispatch_scalar_type(tree.type(), [&](auto zero) {
+        using T = decltype(zero);
+        const Octree<T>& octree = *tree.as<T>();
+        for (int py = 0; py < frame.height; ++py)
+            for (int px = 0; px < frame.width; ++px) {
+                const size_t i = size_t(py) * size_t(frame.width) + size_t(px);
+                const float t = frame.depth[i];
+                uint8_t* out = &frame.rgb[3 * i];
+                if (!std::isfinite(t)) {
+                    for (int a = 0; a < 3; ++a) out[a] = to_srgb8(shading.background[size_t(a)]);
+                    continue;
+                }
+                const Ray ray = pinhole.ray(px, py);
+                const Vec3 normal{frame.normal[3 * i], frame.normal[3 * i + 1], frame.normal[3 * i + 2]};
+                int iso = 0;
+                if (isovalues.size() > 1) {
+                    const Vec3 p{ray.origin[0] + double(t) * ray.dir[0], ray.origin[1] + double(t) * ray.dir[1],
+                                 ray.origin[2] + double(t) * ray.dir[2]};
+                    iso = nearest_isovalue(field_at(octree, tree.placement(), p), isovalues);
+                }
+                const float* albedo = size_t(iso) < shading.colours.size() && shading.colours[size_t(iso)]
+                                          ? shading.colours[size_t(iso)]->data()
+                                          : kAlbedo[iso % kMaxIsovalues];
+                std::array<double, 3> rgb;
+                if (shading.model == ShadingModel::kit) {
+                    rgb = shade_light_kit(kit, to_light, normal, ray.dir, albedo);
+                } else {
+                    const double lambert = std::fabs(vec_dot(normal, ray.dir));
+                    for (int a = 0; a < 3; ++a) rgb[a] = albedo[a] * (kAmbient + (1.0f - kAmbient) * lambert);
+                }
+                for (int a = 0; a < 3; ++a) out[a] = to_srgb8(float(rgb[size_t(a)]));
+            }
+    });
+}
+
+std::array<float, 3> parse_colour(const std::string& text, const std::string& flag) {
+    std::array<double, 3> srgb{};
+    const auto bad = [&] { return Error(flag, "expected R,G,B in [0, 1] or #RRGGBB, found '" + text + "'"); };
+    if (!text.empty() && text[0] == '#') {
+        if (text.size() != 7) throw bad();
+        for (int a = 0; a < 3; ++a) {
+            unsigned v = 0;
+            const char* b = text.data() + 1 + 2 * a;
+            const auto [p, ec] = std::from_chars(b, b + 2, v, 16);
+            if (ec != std::errc() || p != b + 2) throw bad();
+            srgb[size_t(a)] = v / 255.0;
+        }
+    } else {
+        size_t start = 0;
+        for (int a = 0; a < 3; ++a) {
+            const size_t comma = text.find(',', start);
+            if ((a < 2) != (comma != std::string::npos)) throw bad();
+            const std::string part = text.substr(start, a < 2 ? comma - start : std::string::npos);
+            double v = 0;
+            const auto [p, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+            if (part.empty() || ec != std::errc() || p != part.data() + part.size() || !(v >= 0 && v <= 1)) throw bad();
+            srgb[size_t(a)] = v;
+            start = comma + 1;
+        }
+    }
+    return {linear_from_srgb(srgb[0]), linear_from_srgb(srgb[1]), linear_from_srgb(srgb[2])};
+}
+
+}  // namespace octiso

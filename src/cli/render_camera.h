@@ -1,0 +1,31 @@
+// octiso-render's camera flags turned into the cameras of a run (issue 17, item 8): the default
+// three-quarter framing, --view NAME, --azimuth/--elevation/--zoom around the data centre,
+// --orbit N (N cameras around the centre), then --eye/--look/--up/--fov as explicit overrides;
+// and the text that reproduces a camera (flags a user can paste back).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli/common/cli.h"
+#include "octiso/camera.h"
+#include "octiso/oct_file.h"
+
+namespace octiso::cli {
+
+struct CameraFlags {
+    std::optional<std::string> eye, look, up, fov, size, view, azimuth, elevation, zoom, orbit;
+    /// Consumes the camera flags from `args`.
+    static CameraFlags take(Args& args);
+};
+
+/// The cameras of the run: one, or --orbit N of them (azimuth start + 360 i / N). Throws
+/// Error(flag, ...) for a bad value or a combination that has no single meaning (--view with
+/// --azimuth, --orbit with --eye ...).
+std::vector<Camera> cameras_for(const CameraFlags& flags, const OctInfo& info);
+
+/// "--eye X,Y,Z --look X,Y,Z --up X,Y,Z --fov F --size WxH", every number round-tripping.
+std::string camera_flags_text(const Camera& camera);
+
+}  // namespace octiso::cli
