@@ -31,6 +31,11 @@ enum class Traversal { packets, single };
 /// the portable x86-64-v2 build), or one forced (avx2 on a CPU without it is refused). All give
 /// bit-identical frames.
 enum class Isa { automatic, baseline, avx2 };
+/// The kernel `requested` runs on this CPU: automatic picks avx2 where the CPU has AVX2 and FMA,
+/// else baseline; an explicit avx2 on a CPU without them throws Error("isa", ...).
+Isa resolve_isa(Isa requested);
+/// Whether this CPU can run the AVX2 kernel (AVX2 and FMA).
+bool cpu_has_avx2();
 
 struct RenderOptions {
     std::vector<double> isovalues;      ///< 1 .. kMaxIsovalues, each with its own colour

@@ -63,6 +63,9 @@ const char* kUsage =
     "  --root-finder NAME        neubauer|schwarze|linear|exact (default neubauer)\n"
     "  --iterations N            refinement steps of the root finder (default: its own, neubauer 5)\n"
     "  --no-embree               call the traversal directly instead of through Embree (same image)\n"
+    "  --traversal packets|single  8-ray packets of 4x2 pixels, or one ray at a time (default packets;\n"
+    "                            same image)\n"
+    "  --isa auto|baseline|avx2  traversal kernel: auto = AVX2 where the CPU has it (default; same image)\n"
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
     "  --version, -h/--help\n";
 
@@ -106,6 +109,7 @@ int run(std::vector<std::string>& argv) {
     const auto shading_text = args.value("--shading"), background_text = args.value("--background");
     const std::vector<std::string> colour_texts = args.values("--colour");
     const bool no_embree = args.flag("--no-embree"), json = args.flag("--json");
+    const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
     const std::vector<std::string> inputs = args.positional();
     args.finish();
@@ -119,6 +123,17 @@ int run(std::vector<std::string>& argv) {
     options.want_depth = depth_path.has_value();
     options.want_normal = normal_path.has_value();
     options.use_embree = !no_embree;
+    if (traversal_text) {
+        if (*traversal_text == "packets") options.traversal = Traversal::packets;
+        else if (*traversal_text == "single") options.traversal = Traversal::single;
+        else throw Error("--traversal", "expected packets or single, found '" + *traversal_text + "'");
+    }
+    if (isa_text) {
+        if (*isa_text == "auto") options.isa = Isa::automatic;
+        else if (*isa_text == "baseline") options.isa = Isa::baseline;
+        else if (*isa_text == "avx2") options.isa = Isa::avx2;
+        else throw Error("--isa", "expected auto, baseline or avx2, found '" + *isa_text + "'");
+    }
     if (threads) options.threads = int(cli::parse_int(*threads, "--threads", 0, 4096));   // 0: all cores
     if (root_finder) options.root_finder = parse_root_finder_name(*root_finder);
     if (iterations) options.iterations = int(cli::parse_int(*iterations, "--iterations", 0, 1000));
@@ -229,6 +244,8 @@ int run(std::vector<std::string>& argv) {
         j.key("isovalues").array(options.isovalues);
         j.field("width", cameras[0].width).field("height", cameras[0].height);
         j.field("root_finder", std::string(root_finder ? *root_finder : "neubauer")).field("embree", options.use_embree);
+        j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
+        j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
         j.key("camera");
         camera_json(cameras[0]);

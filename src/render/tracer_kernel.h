@@ -25,11 +25,7 @@ struct TracerKernel {
     Isa isa = Isa::baseline;
 };
 
-/// The instruction set `requested` resolves to on this CPU: automatic picks AVX2 where the CPU
-/// has AVX2 and FMA; an explicit avx2 on a CPU without them throws Error("isa", ...).
-Isa resolve_isa(Isa requested);
-/// Whether this CPU can run the AVX2 kernel.
-bool cpu_has_avx2();
+// resolve_isa() and cpu_has_avx2() are public (octiso/render.h); defined in kernel_baseline.cpp.
 
 /// The kernel for `options` (isovalues, root finder, iterations, packet threshold) on `tree`,
 /// for the instruction set `isa` (resolved: baseline or avx2). The tree's storage must outlive it.
