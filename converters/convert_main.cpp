@@ -21,7 +21,7 @@ using namespace octiso;
 constexpr const char* kUsage =
     "usage: octiso-convert INPUT -o OUT.oct [--dims NX,NY,NZ --type T [--endian little|big] [--offset BYTES]]\n"
     "                      [--spacing SX,SY,SZ] [--origin OX,OY,OZ] [--iso-range LO,HI] [--tolerance EPS]\n"
-    "                      [--nan-as V] [--threads N] [--json]\n"
+    "                      [--nan-as V] [--memory BYTES] [--threads N] [--json]\n"
     "       octiso-convert --synthetic NAME:N|NAME:NX,NY,NZ [--type T] -o OUT.oct [options]\n"
     "       octiso-convert --synthetic plume-series:N,STEPS -o SERIES.oct [options]\n"
     "       octiso-convert --synthetic sparse-spheres:N -o OUT.oct [--json]   (N^3 virtual, e.g. 16384)\n"
@@ -29,7 +29,9 @@ constexpr const char* kUsage =
     "       octiso-convert STEP0 STEP1 ... -o SERIES.oct [options]   (a time series, one step per INPUT)\n"
     "INPUT: .nii .nii.gz .vti .vtk .mhd .mha .nrrd .nhdr, or raw (needs --dims and --type)\n"
     "NAME: sphere marschner-lobb sponge noise plume mixing plume-series\n"
-    "T: u8 i8 u16 i16 u32 i32 f32 f64";
+    "T: u8 i8 u16 i16 u32 i32 f32 f64\n"
+    "--memory BYTES (suffix K, M or G; default a quarter of physical memory): raw input is converted\n"
+    "  out of core, slab by slab, within this budget; the file is the same as the in-memory one";
 
 std::string dims_text(Dims d) {
     return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
@@ -46,6 +48,21 @@ std::array<double, 3> positive_vec3(const std::string& text, const std::string& 
     for (double c : v)
         if (!(c > 0)) throw Error(flag, "expected three positive numbers, found '" + text + "'");
     return v;
+}
+
+/// --memory BYTES: a positive integer with an optional K, M or G suffix (powers of 1024).
+uint64_t parse_memory(const std::string& text) {
+    uint64_t scale = 1;
+    std::string digits = text;
+    if (!digits.empty()) {
+        const char last = char(std::toupper(static_cast<unsigned char>(digits.back())));
+        if (last == 'K' || last == 'M' || last == 'G') {
+            scale = last == 'K' ? (1ull << 10) : last == 'M' ? (1ull << 20) : (1ull << 30);
+            digits.pop_back();
+        }
+    }
+    const auto n = uint64_t(cli::parse_int(digits, "--memory", 1, (1LL << 62) / (1LL << 30)));
+    return n * scale;
 }
 
 /// The flags that say where the steps come from, in the order they are checked (so that of
@@ -126,6 +143,8 @@ void write_json(std::ostream& os, const ConvertReport& r) {
     j.field("build_seconds", r.build_seconds).field("total_seconds", r.total_seconds);
     j.field("mvoxels_per_second", r.mvoxels_per_second());
     j.field("peak_rss_bytes", r.peak_rss_bytes).field("threads", r.threads);
+    j.field("streamed", r.streamed).field("memory_budget", r.memory_budget).field("piece_side", r.piece_side);
+    j.field("bytes_read", r.bytes_read).field("spilled_bytes", r.spilled_bytes);
     j.end_object();
     os << "\n";
 }
@@ -145,6 +164,9 @@ void write_human(std::ostream& os, const ConvertReport& r) {
            << (int(k) == r.dmax - 1 ? "  (caps)" : "") << "\n";
     os << "  build " << r.build_seconds << " s (" << r.mvoxels_per_second() << " Mvoxel/s, " << r.threads
        << " threads), total " << r.total_seconds << " s, peak RSS " << mib(r.peak_rss_bytes) << "\n";
+    if (r.streamed)
+        os << "  out of core: --memory " << mib(r.memory_budget) << ", pieces of " << r.piece_side << "^3, read "
+           << mib(r.bytes_read) << ", spilled " << mib(r.spilled_bytes) << "\n";
 }
 
 /// --synthetic sparse-spheres:N (f32, N^3, N >= 64): built directly as an octree, no dense array
@@ -193,11 +215,13 @@ int run(std::vector<std::string>& argv) {
     }
     if (const auto v = args.value("--nan-as")) opt.nan_as = cli::parse_double(*v, "--nan-as");
     if (const auto t = args.value("--threads")) opt.threads = int(cli::parse_int(*t, "--threads", 1, 4096));
+    MemoryOptions memory;
+    if (const auto m = args.value("--memory")) memory.budget = parse_memory(*m);
     const ConvertSource src = parse_source(args);
     args.finish();
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
 
-    const ConvertReport report = octiso::convert(src, *out, opt);
+    const ConvertReport report = octiso::convert(src, *out, opt, memory);
     write_human(std::cerr, report);
     if (json) write_json(std::cout, report);
     return 0;

@@ -2,13 +2,18 @@
 // first, 2. build and stream the steps one at a time into one OctWriter, 3. measure. Building
 // goes through AnyOctree, so no scalar type is named here; sparse-spheres takes its own short
 // path because it never has a dense volume.
+#include <algorithm>
 #include <chrono>
 #include <optional>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <tbb/global_control.h>
 
 #include "convert/same_grid.h"
+#include "convert/stream_build.h"
+#include "io/volume_stream.h"
 #include "octiso/any_octree.h"
 #include "octiso/convert.h"
 #include "octiso/output_guard.h"
@@ -60,9 +65,91 @@ ConvertReport convert_sparse_spheres(const ConvertSource& source, const std::str
     return r;
 }
 
+convert_detail::GridOfStep grid_of(const VolumeStream& s) {
+    return {s.source(), s.format(), s.type(), s.dims(), s.placement(), s.bytes()};
+}
+
+/// Out of core (stream_build.h): every step opened as a stream and checked against the first,
+/// the plan checked against the budget, then the steps built and streamed one at a time.
+ConvertReport convert_streamed(const ConvertSource& source, const std::string& output, const BuildOptions& options,
+                               const MemoryOptions& memory, uint64_t budget, Clock::time_point t_start) {
+    using convert_detail::GridOfStep;
+    const uint32_t n_steps = source.step_count();
+    std::unique_ptr<VolumeStream> step0 = open_volume_stream(source.step_path(0), source.raw_options());
+    const GridOfStep first = grid_of(*step0);
+    for (uint32_t i = 1; i < n_steps; ++i)
+        convert_detail::check_same_grid(first, grid_of(*open_volume_stream(source.step_path(i), source.raw_options())));
+    const convert_detail::StreamPlan plan = convert_detail::plan_stream(first.dims, first.type, options, budget, memory.piece_side, first.source);
+
+    OctInfo info;
+    info.type = first.type;
+    info.dims = first.dims;
+    info.placement = first.placement;
+    info.dmax = dmax_for(first.dims);
+    info.iso_range = options.iso_range;
+    info.tolerance = options.tolerance;
+
+    ConvertReport r;
+    BuildOptions opt = options;
+    OctWriter writer(output, info);
+    const uint64_t all_bytes = first.bytes * n_steps;
+    const uint64_t layer_voxels = uint64_t(first.dims.x) * first.dims.y;
+    for (uint32_t i = 0; i < n_steps; ++i) {
+        std::unique_ptr<VolumeStream> s = i == 0 ? std::move(step0) : open_volume_stream(source.step_path(i), source.raw_options());
+        if (i > 0) convert_detail::check_same_grid(first, grid_of(*s));   // a file may have changed since
+        opt.source_name = s->source();
+        const uint64_t done_before = first.bytes * i;
+        std::function<void(uint32_t)> on_layers;
+        if (memory.on_progress)
+            on_layers = [&](uint32_t layers) {
+                memory.on_progress(done_before + layers * s->layer_bytes(), all_bytes,
+                                   (uint64_t(i) * first.dims.z + layers) * layer_voxels);
+            };
+        const convert_detail::StreamStepResult res =
+            convert_detail::stream_build_step(*s, opt, plan, writer, output, on_layers);
+        r.build_seconds += res.build_seconds;
+        r.spilled_bytes += res.spilled_bytes;
+        r.bytes_read += s->file_bytes_read();
+        add_sizes(r.total, res.sizes);
+        r.per_step.push_back({s->source(), res.sizes, res.build_seconds});
+    }
+    writer.finish();
+
+    struct stat st {};
+    r.file_bytes = ::stat(output.c_str(), &st) == 0 ? uint64_t(st.st_size) : writer.bytes_written();
+    r.peak_rss_bytes = peak_rss_bytes();
+    r.input = source.name();
+    r.output = output;
+    r.format = first.format;
+    r.type = first.type;
+    r.dims = first.dims;
+    r.placement = first.placement;
+    r.dmax = info.dmax;
+    r.steps = n_steps;
+    r.iso_range = options.iso_range;
+    r.tolerance = options.tolerance;
+    r.input_bytes = all_bytes;
+    r.threads = active_threads();
+    r.streamed = true;
+    r.memory_budget = budget;
+    r.piece_side = plan.piece_side;
+    r.total_seconds = seconds_since(t_start);
+    return r;
+}
+
 }  // namespace
 
-ConvertReport convert(const ConvertSource& source, const std::string& output, const BuildOptions& options) {
+uint64_t default_memory_budget() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+    uint64_t budget = pages > 0 && page > 0 ? uint64_t(pages) / 4 * uint64_t(page) : uint64_t(1) << 30;
+    // Under ulimit -v the address space is the tighter limit: keep half of it for everything else.
+    struct rlimit as {};
+    if (::getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY) budget = std::min<uint64_t>(budget, as.rlim_cur / 2);
+    return budget;
+}
+
+ConvertReport convert(const ConvertSource& source, const std::string& output, const BuildOptions& options,
+                      const MemoryOptions& memory) {
     using convert_detail::check_same_grid;
     using convert_detail::GridOfStep;
     const Clock::time_point t_start = Clock::now();
@@ -75,11 +162,30 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     std::optional<tbb::global_control> limit;   // reading, generating and building alike
     if (options.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(options.threads));
 
+    // 0. In memory or out of core. The in-memory build holds the input and the whole octree, about
+    //    twice the input (BENCHMARKS.md, compression: 1.1x of input + output).
+    const uint64_t budget = memory.budget.value_or(default_memory_budget());
+    if (memory.budget && *memory.budget == 0) throw Error("--memory", "must be > 0");
+    const bool streamable = !source.is_synthetic() && is_streamable(source.step_path(0), source.raw_options());
+    if (streamable) {
+        // Bad dims are reported by either reader with the same words; let the in-memory one do it.
+        const Dims d = *source.raw_options().dims;
+        const bool valid = d.x && d.y && d.z && d.max_extent() <= Dims::kMaxExtent &&
+                           d.voxels() / d.x / d.y == d.z && d.voxels() <= UINT64_MAX / 8;
+        const bool fits = !valid || d.voxels() * scalar_type_bytes(*source.raw_options().type) <= budget / 2;
+        if (memory.budget || memory.force_streaming || !fits)
+            return convert_streamed(source, output, options, memory, budget, t_start);
+    }
+
     // 1. Open every step and compare it with the first before anything is written. For raw
     //    input this only maps files; other formats are read once here and once when converted.
     const uint32_t n_steps = source.step_count();
     std::optional<LoadedVolume> step0 = source.load(0);
     const GridOfStep first(*step0);
+    if (memory.budget && !source.is_synthetic() && first.bytes > *memory.budget)
+        throw Error(first.source, std::string(volume_format_name(first.format)) + " input is read whole (through VTK): its " +
+                                      std::to_string(first.bytes) + " voxel bytes exceed --memory " +
+                                      std::to_string(*memory.budget) + " (convert it to raw to stream it)");
     if (!source.is_synthetic())
         for (uint32_t i = 1; i < n_steps; ++i) check_same_grid(first, source.load(i));
 
@@ -128,6 +234,7 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     r.tolerance = options.tolerance;
     r.input_bytes = first.bytes * n_steps;
     r.threads = active_threads();
+    r.memory_budget = budget;
     r.total_seconds = seconds_since(t_start);
     return r;
 }

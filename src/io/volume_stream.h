@@ -1,0 +1,78 @@
+// VolumeStream: a volume read front to back, a few layers (z slices) at a time, for the
+// out-of-core converter (issue 13). Unlike LoadedVolume nothing is mapped or kept: each call
+// reads the next layers with ordinary reads into the caller's buffer, in native byte order.
+// The readers behind it: raw_stream.cpp (raw arrays); open_volume_stream() picks one.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "octiso/loaded_volume.h"
+#include "octiso/reader.h"
+#include "octiso/volume.h"
+
+namespace octiso {
+
+/// Invariants: dims() passed checked_volume_bytes; next_layer() <= dims().z counts the layers
+/// handed out so far. Not thread-safe (one reader, one cursor).
+class VolumeStream {
+public:
+    VolumeStream(ScalarType type, Dims dims, Placement placement, std::string source, VolumeFormat format)
+        : type_(type), dims_(dims), placement_(placement), source_(std::move(source)), format_(format) {}
+    virtual ~VolumeStream() = default;
+    VolumeStream(const VolumeStream&) = delete;
+    VolumeStream& operator=(const VolumeStream&) = delete;
+
+    ScalarType type() const { return type_; }
+    Dims dims() const { return dims_; }
+    const Placement& placement() const { return placement_; }
+    void set_placement(const Placement& p) { placement_ = p; }
+    const std::string& source() const { return source_; }
+    VolumeFormat format() const { return format_; }
+    uint64_t layer_bytes() const { return uint64_t(dims_.x) * dims_.y * scalar_type_bytes(type_); }
+    uint64_t bytes() const { return layer_bytes() * dims_.z; }   ///< dense voxel bytes of the step
+    uint32_t next_layer() const { return next_layer_; }
+    /// Bytes taken from the file so far (compressed bytes for gzip input).
+    virtual uint64_t file_bytes_read() const = 0;
+
+    /// Reads layers next_layer() .. next_layer()+n-1 (x fastest, native byte order) into `dst`,
+    /// which holds n * layer_bytes() bytes. Throws Error(source(), ...) past the last layer or
+    /// when the file ends early or cannot be read.
+    void read_layers(uint32_t n, std::byte* dst) {
+        if (n > dims_.z - next_layer_)
+            throw Error(source_, "read past the last layer (" + std::to_string(next_layer_) + " + " + std::to_string(n) +
+                                     " > " + std::to_string(dims_.z) + ")", ErrorKind::Other);
+        read_bytes(uint64_t(n) * layer_bytes(), dst);
+        next_layer_ += n;
+    }
+
+protected:
+    /// The next `bytes` voxel bytes of the file in native byte order.
+    virtual void read_bytes(uint64_t bytes, std::byte* dst) = 0;
+
+private:
+    ScalarType type_;
+    Dims dims_;
+    Placement placement_;
+    std::string source_;
+    VolumeFormat format_;
+    uint32_t next_layer_ = 0;
+};
+
+/// A raw array (CONVENTIONS 3) checked like read_raw() (dims, then exactly offset + voxel bytes),
+/// read with pread in slabs; big-endian data is swapped as it is read.
+std::unique_ptr<VolumeStream> open_raw_stream(const std::string& path, Dims dims, ScalarType type, Endian endian,
+                                              uint64_t offset);
+
+/// Whether open_volume_stream() can stream `path` (raw input so far); other formats are read
+/// whole by open_volume().
+bool is_streamable(const std::string& path, const RawOptions& options);
+
+/// The streaming counterpart of open_volume(): the same format choice, flag checks, placement
+/// overrides and placement check. Throws Error naming the file or flag; also when the format
+/// cannot be streamed (check is_streamable first).
+std::unique_ptr<VolumeStream> open_volume_stream(const std::string& path, const RawOptions& options);
+
+}  // namespace octiso
