@@ -2,9 +2,13 @@
 // of them -> one .oct file (CONVENTIONS 3). This file only parses the flags into a
 // ConvertSource and BuildOptions and prints the ConvertReport (text on stderr, or exactly one
 // JSON object on stdout); the pipeline itself is the library's convert() (octiso/convert.h).
+#include <chrono>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+
+#include <unistd.h>
 
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
@@ -21,7 +25,7 @@ using namespace octiso;
 constexpr const char* kUsage =
     "usage: octiso-convert INPUT -o OUT.oct [--dims NX,NY,NZ --type T [--endian little|big] [--offset BYTES]]\n"
     "                      [--spacing SX,SY,SZ] [--origin OX,OY,OZ] [--iso-range LO,HI] [--tolerance EPS]\n"
-    "                      [--nan-as V] [--memory BYTES] [--threads N] [--json]\n"
+    "                      [--nan-as V] [--memory BYTES | --in-memory] [--threads N] [--json]\n"
     "       octiso-convert --synthetic NAME:N|NAME:NX,NY,NZ [--type T] -o OUT.oct [options]\n"
     "       octiso-convert --synthetic plume-series:N,STEPS -o SERIES.oct [options]\n"
     "       octiso-convert --synthetic sparse-spheres:N -o OUT.oct [--json]   (N^3 virtual, e.g. 16384)\n"
@@ -31,7 +35,8 @@ constexpr const char* kUsage =
     "NAME: sphere marschner-lobb sponge noise plume mixing plume-series\n"
     "T: u8 i8 u16 i16 u32 i32 f32 f64\n"
     "--memory BYTES (suffix K, M or G; default a quarter of physical memory): raw input is converted\n"
-    "  out of core, slab by slab, within this budget; the file is the same as the in-memory one";
+    "  out of core, slab by slab, within this budget; the file is the same as the in-memory one\n"
+    "--in-memory: the whole-array path whatever the input's size (benchmarks)";
 
 std::string dims_text(Dims d) {
     return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
@@ -49,6 +54,37 @@ std::array<double, 3> positive_vec3(const std::string& text, const std::string& 
         if (!(c > 0)) throw Error(flag, "expected three positive numbers, found '" + text + "'");
     return v;
 }
+
+/// Progress of an out-of-core conversion on stderr (issue 13): only when stderr is a terminal,
+/// not with --json, and only once the conversion has run for a second; redrawn at most 4 times a
+/// second on one line, which finish() ends. Bytes are the input's voxel bytes.
+class ProgressLine {
+public:
+    explicit ProgressLine(bool wanted) : wanted_(wanted && ::isatty(STDERR_FILENO)), t0_(Clock::now()) {}
+    void update(uint64_t done, uint64_t all, uint64_t voxels) {
+        if (!wanted_) return;
+        const auto now = Clock::now();
+        const double t = std::chrono::duration<double>(now - t0_).count();
+        if (t < 1.0 || (shown_ && std::chrono::duration<double>(now - last_).count() < 0.25)) return;
+        last_ = now;
+        shown_ = true;
+        const double rate = double(done) / t;
+        const double eta = rate > 0 ? double(all - std::min(done, all)) / rate : 0;
+        std::fprintf(stderr, "\r  read %.0f of %.0f MiB, %.1f Mvoxel/s, ETA %.0f s   ", double(done) / 1048576.0,
+                     double(all) / 1048576.0, double(voxels) / t / 1e6, eta);
+        std::fflush(stderr);
+    }
+    void finish() {
+        if (shown_) std::fputc('\n', stderr);
+        shown_ = false;
+    }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    bool wanted_;
+    bool shown_ = false;
+    Clock::time_point t0_, last_;
+};
 
 /// --memory BYTES: a positive integer with an optional K, M or G suffix (powers of 1024).
 uint64_t parse_memory(const std::string& text) {
@@ -217,11 +253,21 @@ int run(std::vector<std::string>& argv) {
     if (const auto t = args.value("--threads")) opt.threads = int(cli::parse_int(*t, "--threads", 1, 4096));
     MemoryOptions memory;
     if (const auto m = args.value("--memory")) memory.budget = parse_memory(*m);
+    memory.force_in_memory = args.flag("--in-memory");
     const ConvertSource src = parse_source(args);
     args.finish();
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
 
-    const ConvertReport report = octiso::convert(src, *out, opt, memory);
+    ProgressLine progress(!json);
+    memory.on_progress = [&](uint64_t done, uint64_t all, uint64_t voxels) { progress.update(done, all, voxels); };
+    ConvertReport report;
+    try {
+        report = octiso::convert(src, *out, opt, memory);
+    } catch (...) {
+        progress.finish();   // the error line starts on a line of its own
+        throw;
+    }
+    progress.finish();
     write_human(std::cerr, report);
     if (json) write_json(std::cout, report);
     return 0;

@@ -72,6 +72,7 @@ struct MemoryOptions {
     std::optional<uint64_t> budget;
     uint32_t piece_side = 0;   ///< forces the out-of-core pieces' side (a power of two >= 4; tests); 0: from the budget
     bool force_streaming = false;   ///< out of core even without a budget (tests)
+    bool force_in_memory = false;   ///< --in-memory: the whole-array path whatever the size (benchmarks)
     /// Called from the converting thread after each slab with (bytes read so far, bytes in all, voxels
     /// built so far); for progress reports. Not called on the in-memory path.
     std::function<void(uint64_t, uint64_t, uint64_t)> on_progress;

@@ -13,6 +13,7 @@
 
 #include "convert/same_grid.h"
 #include "convert/stream_build.h"
+#include "io/nifti_header.h"
 #include "io/volume_stream.h"
 #include "octiso/any_octree.h"
 #include "octiso/convert.h"
@@ -74,11 +75,18 @@ convert_detail::GridOfStep grid_of(const VolumeStream& s) {
 ConvertReport convert_streamed(const ConvertSource& source, const std::string& output, const BuildOptions& options,
                                const MemoryOptions& memory, uint64_t budget, Clock::time_point t_start) {
     using convert_detail::GridOfStep;
-    const uint32_t n_steps = source.step_count();
+    const uint32_t n_files = source.step_count();
     std::unique_ptr<VolumeStream> step0 = open_volume_stream(source.step_path(0), source.raw_options());
     const GridOfStep first = grid_of(*step0);
-    for (uint32_t i = 1; i < n_steps; ++i)
-        convert_detail::check_same_grid(first, grid_of(*open_volume_stream(source.step_path(i), source.raw_options())));
+    for (uint32_t i = 1; i < n_files; ++i) {
+        const std::unique_ptr<VolumeStream> s = open_volume_stream(source.step_path(i), source.raw_options());
+        convert_detail::check_same_grid(first, grid_of(*s));
+        if (s->time_steps() != 1) throw Error(s->source(), "a 4-D file is a series by itself; list only 3-D files");
+    }
+    // A 4-D NIfTI is a time series in one file: its volumes are the steps, read from one stream.
+    const uint32_t per_file = step0->time_steps();
+    if (per_file != 1 && n_files != 1) throw Error(step0->source(), "a 4-D file is a series by itself; list only 3-D files");
+    const uint32_t n_steps = n_files * per_file;
     const convert_detail::StreamPlan plan = convert_detail::plan_stream(first.dims, first.type, options, budget, memory.piece_side, first.source);
 
     OctInfo info;
@@ -95,8 +103,11 @@ ConvertReport convert_streamed(const ConvertSource& source, const std::string& o
     const uint64_t all_bytes = first.bytes * n_steps;
     const uint64_t layer_voxels = uint64_t(first.dims.x) * first.dims.y;
     for (uint32_t i = 0; i < n_steps; ++i) {
-        std::unique_ptr<VolumeStream> s = i == 0 ? std::move(step0) : open_volume_stream(source.step_path(i), source.raw_options());
-        if (i > 0) convert_detail::check_same_grid(first, grid_of(*s));   // a file may have changed since
+        std::unique_ptr<VolumeStream> opened;
+        if (per_file == 1) opened = i == 0 ? std::move(step0) : open_volume_stream(source.step_path(i), source.raw_options());
+        else if (i > 0) step0->start_next_step();
+        VolumeStream* s = per_file == 1 ? opened.get() : step0.get();
+        if (i > 0 && per_file == 1) convert_detail::check_same_grid(first, grid_of(*s));   // a file may have changed since
         opt.source_name = s->source();
         const uint64_t done_before = first.bytes * i;
         std::function<void(uint32_t)> on_layers;
@@ -109,7 +120,7 @@ ConvertReport convert_streamed(const ConvertSource& source, const std::string& o
             convert_detail::stream_build_step(*s, opt, plan, writer, output, on_layers);
         r.build_seconds += res.build_seconds;
         r.spilled_bytes += res.spilled_bytes;
-        r.bytes_read += s->file_bytes_read();
+        if (per_file == 1 || i + 1 == n_steps) r.bytes_read += s->file_bytes_read();
         add_sizes(r.total, res.sizes);
         r.per_step.push_back({s->source(), res.sizes, res.build_seconds});
     }
@@ -166,14 +177,23 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     //    twice the input (BENCHMARKS.md, compression: 1.1x of input + output).
     const uint64_t budget = memory.budget.value_or(default_memory_budget());
     if (memory.budget && *memory.budget == 0) throw Error("--memory", "must be > 0");
-    const bool streamable = !source.is_synthetic() && is_streamable(source.step_path(0), source.raw_options());
+    if (memory.force_in_memory && (memory.budget || memory.force_streaming))
+        throw Error("--in-memory", "does not combine with --memory");
+    const bool streamable =
+        !memory.force_in_memory && !source.is_synthetic() && is_streamable(source.step_path(0), source.raw_options());
     if (streamable) {
         // Bad dims are reported by either reader with the same words; let the in-memory one do it.
-        const Dims d = *source.raw_options().dims;
+        const bool nifti = detect_volume_format(source.step_path(0)) == VolumeFormat::nifti && !source.raw_options().dims;
+        std::optional<io::NiftiHeader> header;
+        if (nifti) header = io::read_nifti_header(source.step_path(0));
+        const Dims d = nifti ? header->dims : *source.raw_options().dims;
+        const ScalarType t = nifti ? header->type : *source.raw_options().type;
         const bool valid = d.x && d.y && d.z && d.max_extent() <= Dims::kMaxExtent &&
                            d.voxels() / d.x / d.y == d.z && d.voxels() <= UINT64_MAX / 8;
-        const bool fits = !valid || d.voxels() * scalar_type_bytes(*source.raw_options().type) <= budget / 2;
-        if (memory.budget || memory.force_streaming || !fits)
+        const bool fits = !valid || d.voxels() * scalar_type_bytes(t) <= budget / 2;
+        // VTK reads a 4-D NIfTI as components, which octiso refuses: only the stream reads its steps.
+        const bool four_d = nifti && header->time_steps > 1;
+        if (memory.budget || memory.force_streaming || !fits || four_d)
             return convert_streamed(source, output, options, memory, budget, t_start);
     }
 

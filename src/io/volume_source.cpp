@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "io/input_file.h"
+#include "io/nifti_header.h"
 #include "io/volume_stream.h"
 #include "octiso/reader.h"
 
@@ -139,12 +140,20 @@ LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
                               ? read_raw(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
                                          options.offset.value_or(0))
                               : read_vtk(path, format);
+    if (format == VolumeFormat::nifti) {
+        // CONVENTIONS 2b: an axis-aligned sform/qform places the grid, as the streaming reader
+        // does, so both paths write the same header. Not where VTK reverses the slices (qfac -1)
+        // or the affine flips or rotates an axis: VTK's placement stays for those.
+        const io::NiftiHeader h = io::read_nifti_header(path);
+        if (h.unplaced.empty() && h.qfac > 0) volume.set_placement(h.placement);
+    }
     volume.set_placement(overridden_placement(volume.placement(), volume.dims(), path, options));
     return volume;
 }
 
 bool is_streamable(const std::string& path, const RawOptions& options) {
-    return choose_format(path, options) == VolumeFormat::raw;
+    const VolumeFormat f = choose_format(path, options);
+    return f == VolumeFormat::raw || f == VolumeFormat::nifti;
 }
 
 std::unique_ptr<VolumeStream> open_volume_stream(const std::string& path, const RawOptions& options) {
@@ -153,6 +162,8 @@ std::unique_ptr<VolumeStream> open_volume_stream(const std::string& path, const 
     if (format == VolumeFormat::raw)
         s = open_raw_stream(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
                             options.offset.value_or(0));
+    else if (format == VolumeFormat::nifti)
+        s = open_nifti_stream(path);
     else
         throw Error(path, std::string(volume_format_name(format)) + " input is read whole, not streamed", ErrorKind::Other);
     s->set_placement(overridden_placement(s->placement(), s->dims(), path, options));
