@@ -16,7 +16,7 @@ SpillFile::SpillFile(std::string name, SpillAllowance& allowance) : name_(std::m
 
 SpillFile::~SpillFile() {
     if (fd_ >= 0) ::close(fd_);
-    allowance_.bytes_left += charged_;
+    release_memory();
 }
 
 void SpillFile::move_to_disk() {
@@ -24,41 +24,64 @@ void SpillFile::move_to_disk() {
     fd_ = ::open(temp_->temp_path().c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
     if (fd_ < 0)
         throw Error(temp_->temp_path(), std::string("cannot create a temporary: ") + std::strerror(errno), ErrorKind::Other);
-    if (!io::write_all(fd_, memory_.data(), memory_.size()))
-        throw Error(temp_->temp_path(), std::string("write failed: ") + std::strerror(errno), ErrorKind::Other);
+    for (uint64_t at = 0; at < size_; at += kBlockBytes)
+        if (!io::write_all(fd_, blocks_[size_t(at / kBlockBytes)].get(), std::min(kBlockBytes, size_ - at)))
+            throw Error(temp_->temp_path(), std::string("write failed: ") + std::strerror(errno), ErrorKind::Other);
+    release_memory();
+    on_disk_ = true;
+}
+
+void SpillFile::release_memory() {
+    blocks_.clear();
     allowance_.bytes_left += charged_;
     charged_ = 0;
-    std::vector<std::byte>().swap(memory_);
-    on_disk_ = true;
 }
 
 uint64_t SpillFile::append(const void* data, uint64_t n) {
     const uint64_t at = size_;
-    if (!on_disk_ && n > allowance_.bytes_left) move_to_disk();
+    if (!on_disk_) {
+        // Whole new blocks this append needs, paid for before any is taken.
+        const uint64_t have = uint64_t(blocks_.size()) * kBlockBytes;
+        const uint64_t need = size_ + n > have ? (size_ + n - have + kBlockBytes - 1) / kBlockBytes * kBlockBytes : 0;
+        if (need > allowance_.bytes_left) move_to_disk();
+    }
     if (on_disk_) {
         if (!io::write_all(fd_, data, n))
             throw Error(temp_->temp_path(), std::string("write failed: ") + std::strerror(errno), ErrorKind::Other);
-    } else {
-        const auto* p = static_cast<const std::byte*>(data);
-        const size_t before = memory_.capacity();
-        memory_.insert(memory_.end(), p, p + n);
-        // The allowance pays for the capacity actually held, growth slack included.
-        const uint64_t grown = std::min<uint64_t>(memory_.capacity() - before, allowance_.bytes_left);
-        allowance_.bytes_left -= grown;
-        charged_ += grown;
+        size_ += n;
+        return at;
     }
-    size_ += n;
+    const auto* p = static_cast<const std::byte*>(data);
+    uint64_t done = 0;
+    while (done < n) {
+        const uint64_t in_block = size_ % kBlockBytes;
+        if (in_block == 0 && size_ / kBlockBytes == blocks_.size()) {
+            blocks_.push_back(std::unique_ptr<std::byte[]>(new std::byte[kBlockBytes]));
+            allowance_.bytes_left -= kBlockBytes;
+            charged_ += kBlockBytes;
+        }
+        const uint64_t k = std::min(n - done, kBlockBytes - in_block);
+        std::memcpy(blocks_[size_t(size_ / kBlockBytes)].get() + in_block, p + done, size_t(k));
+        done += k;
+        size_ += k;
+    }
     return at;
 }
 
 void SpillFile::read(uint64_t offset, uint64_t n, void* dst) const {
     if (offset > size_ || n > size_ - offset)
         throw Error(name_, "spill read past its end", ErrorKind::Other);
+    auto* p = static_cast<char*>(dst);
     if (!on_disk_) {
-        std::memcpy(dst, memory_.data() + offset, size_t(n));
+        uint64_t done = 0;
+        while (done < n) {
+            const uint64_t at = offset + done, in_block = at % kBlockBytes;
+            const uint64_t k = std::min(n - done, kBlockBytes - in_block);
+            std::memcpy(p + done, blocks_[size_t(at / kBlockBytes)].get() + in_block, size_t(k));
+            done += k;
+        }
         return;
     }
-    auto* p = static_cast<char*>(dst);
     uint64_t done = 0;
     while (done < n) {
         const ssize_t r = ::pread(fd_, p + done, size_t(std::min<uint64_t>(n - done, uint64_t(1) << 30)), off_t(offset + done));
@@ -76,9 +99,7 @@ void SpillFile::clear() {
         if (::lseek(fd_, 0, SEEK_SET) < 0)
             throw Error(temp_->temp_path(), std::string("seek failed: ") + std::strerror(errno), ErrorKind::Other);
     }
-    allowance_.bytes_left += charged_;
-    charged_ = 0;
-    std::vector<std::byte>().swap(memory_);
+    release_memory();
     size_ = 0;
 }
 
