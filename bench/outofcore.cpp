@@ -158,7 +158,7 @@ int run_outofcore(cli::Args& args) {
     table.print(std::cout);
     std::cout << "the two .oct files are " << (identical ? "identical, byte for byte" : "DIFFERENT") << "; throughput "
               << fmt(100.0 * rows[0].mvoxels_per_second / rows[1].mvoxels_per_second, 1) << " % of in-memory\n";
-    const std::string path = write_json(results, "outofcore", [&](cli::JsonWriter& j) {
+    const std::string path = write_json(results, quick ? "outofcore" : "outofcore_" + tag, [&](cli::JsonWriter& j) {
         j.field("dims", tag).field("type", std::string("u8")).field("input_bytes", voxels).field("memory", memory);
         j.field("machine", machine_description()).field("identical", identical).field("input_sha256", input_sha);
         j.key("paths").begin_array();

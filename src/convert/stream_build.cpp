@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -43,30 +45,38 @@ struct Halo {
 };
 Halo halo_of(const BuildOptions& options) { return options.iso_range ? Halo{1, 2} : Halo{0, 1}; }
 
-uint64_t slab_need(Dims dims, uint64_t b, const BuildOptions& options, uint32_t s, bool is_float) {
+// The estimates are doubles: a hostile grid (2^30 x 2^30 layers) must compare as too large, not
+// wrap around 2^64 and pass.
+double slab_need(Dims dims, double b, const BuildOptions& options, uint32_t s, bool is_float) {
     const Halo h = halo_of(options);
-    const uint64_t layer = uint64_t(dims.x) * dims.y;
-    const uint64_t region = layer * std::min<uint64_t>(uint64_t(s) + h.below + h.above, dims.z);
-    uint64_t need = region * b;                                      // the layers themselves
+    const double layer = double(dims.x) * dims.y;
+    const double region = layer * double(std::min<uint64_t>(uint64_t(s) + h.below + h.above, dims.z));
+    double need = region * b;                                        // the layers themselves
     if (options.nan_as && is_float) need += region * b;              // the --nan-as copy
     if (options.iso_range) need += region * b + region;              // clamped copy + flags
     const uint64_t s_data = std::min<uint64_t>(s, dims.z);
-    const uint64_t caps = ceil_div(dims.x, 2) * ceil_div(dims.y, 2) * ceil_div(s_data, 2) * 8 * b;
-    const uint64_t nodes = ceil_div(dims.x, 4) * ceil_div(dims.y, 4) * ceil_div(s_data, 4) * (24 * b + 8) * 8 / 7;
+    const double caps = double(ceil_div(dims.x, 2)) * double(ceil_div(dims.y, 2)) * double(ceil_div(s_data, 2)) * 8 * b;
+    const double nodes =
+        double(ceil_div(dims.x, 4)) * double(ceil_div(dims.y, 4)) * double(ceil_div(s_data, 4)) * (24 * b + 8) * 8 / 7;
     need += 2 * (caps + nodes);                                      // the pieces' vectors, growth slack
     return need;
 }
 
-uint64_t fixed_need(Dims dims, uint64_t b, uint32_t s) {
+double fixed_need(Dims dims, double b, uint32_t s) {
     const int dmax = dmax_for(dims);
-    const uint64_t pieces = ceil_div(dims.x, s) * ceil_div(dims.y, s) * ceil_div(dims.z, s);
-    const uint64_t levels = uint64_t(std::countr_zero(s));
-    const uint64_t per_piece = levels * 4 + 48 + 4;                  // counts, Summary<T>, order
-    const uint64_t staging = uint64_t(s) * s * s * b + uint64_t(s) * s * s / 8 * (24 * b + 8);
-    return pieces * per_piece + staging + uint64_t(dmax) * 4096;
+    const double pieces = double(ceil_div(dims.x, s)) * double(ceil_div(dims.y, s)) * double(ceil_div(dims.z, s));
+    const double levels = double(std::countr_zero(s));
+    const double per_piece = levels * 4 + 48 + 4 + 8;                // counts, Summary<T>, order, chunk offset
+    const double cube = double(s) * s * s;
+    const double staging = cube * b + cube / 8 * (24 * b + 8);
+    return pieces * per_piece + staging + double(dmax) * 4096;
 }
 
-std::string mib(uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; }
+std::string mib_text(double b) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.0f MiB", std::ceil(b / 1048576.0));
+    return text;
+}
 
 template <typename T> class StepBuilder {
 public:
@@ -278,7 +288,7 @@ private:
 
 StreamPlan plan_stream(Dims dims, ScalarType type, const BuildOptions& options, uint64_t budget, uint32_t forced_side,
                        const std::string& subject) {
-    const uint64_t b = scalar_type_bytes(type);
+    const double b = double(scalar_type_bytes(type));
     const bool is_float = type == ScalarType::f32 || type == ScalarType::f64;
     const uint32_t top_side = 1u << dmax_for(dims);
     auto need = [&](uint32_t s) { return slab_need(dims, b, options, s, is_float) + fixed_need(dims, b, s); };
@@ -291,20 +301,20 @@ StreamPlan plan_stream(Dims dims, ScalarType type, const BuildOptions& options, 
         const uint32_t largest = std::min(kMaxPieceSide, top_side);
         p.piece_side = kMinPieceSide;
         for (uint32_t s = largest; s > kMinPieceSide; s /= 2)
-            if (need(s) <= budget / 2) {
+            if (need(s) <= double(budget) / 2) {
                 p.piece_side = s;
                 break;
             }
     }
-    p.slab_bytes = slab_need(dims, b, options, p.piece_side, is_float);
-    p.fixed_bytes = fixed_need(dims, b, p.piece_side);
-    const uint64_t total = p.slab_bytes + p.fixed_bytes;
-    if (total > budget)
+    const double total = slab_need(dims, b, options, p.piece_side, is_float) + fixed_need(dims, b, p.piece_side);
+    if (total > double(budget))
         throw Error(subject, "out of memory: one slab of " + std::to_string(p.piece_side) + " layers of " +
                                  std::to_string(dims.x) + "x" + std::to_string(dims.y) + " " +
-                                 std::string(scalar_type_name(type)) + " needs " + mib(total) +
-                                 ", more than the memory budget of " + mib(budget) + " (--memory)");
-    p.spill_memory = budget - total;
+                                 std::string(scalar_type_name(type)) + " needs " + mib_text(total) +
+                                 ", more than the memory budget of " + mib_text(double(budget)) + " (--memory)");
+    p.slab_bytes = uint64_t(std::ceil(slab_need(dims, b, options, p.piece_side, is_float)));
+    p.fixed_bytes = uint64_t(std::ceil(fixed_need(dims, b, p.piece_side)));
+    p.spill_memory = budget - std::min(budget, p.slab_bytes + p.fixed_bytes);
     return p;
 }
 
