@@ -13,6 +13,7 @@
 
 #include "convert/same_grid.h"
 #include "convert/stream_build.h"
+#include "io/header_check.h"
 #include "io/nifti_header.h"
 #include "io/volume_stream.h"
 #include "octiso/any_octree.h"
@@ -200,12 +201,24 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     // 1. Open every step and compare it with the first before anything is written. For raw
     //    input this only maps files; other formats are read once here and once when converted.
     const uint32_t n_steps = source.step_count();
+    // Input VTK must read whole is refused over an explicit budget before VTK allocates it, from
+    // the header's declaration (header_check.h), and again after reading if the header said nothing.
+    auto too_big_for_budget = [&](const std::string& path, VolumeFormat format, uint64_t bytes) {
+        return Error(path, std::string(volume_format_name(format)) + " input is read whole (through VTK): its " +
+                               std::to_string(bytes) + " voxel bytes exceed --memory " + std::to_string(*memory.budget) +
+                               " (convert it to raw to stream it)");
+    };
+    if (memory.budget && !source.is_synthetic() && !source.raw_options().dims && !source.raw_options().type) {
+        const VolumeFormat f = detect_volume_format(source.step_path(0));
+        if (f != VolumeFormat::raw && f != VolumeFormat::nifti) {
+            const uint64_t declared = io::check_declared_size(source.step_path(0), f);
+            if (declared > *memory.budget) throw too_big_for_budget(source.step_path(0), f, declared);
+        }
+    }
     std::optional<LoadedVolume> step0 = source.load(0);
     const GridOfStep first(*step0);
     if (memory.budget && !source.is_synthetic() && first.bytes > *memory.budget)
-        throw Error(first.source, std::string(volume_format_name(first.format)) + " input is read whole (through VTK): its " +
-                                      std::to_string(first.bytes) + " voxel bytes exceed --memory " +
-                                      std::to_string(*memory.budget) + " (convert it to raw to stream it)");
+        throw too_big_for_budget(first.source, first.format, first.bytes);
     if (!source.is_synthetic())
         for (uint32_t i = 1; i < n_steps; ++i) check_same_grid(first, source.load(i));
 
