@@ -2,9 +2,13 @@
 // of them -> one .oct file (CONVENTIONS 3). This file only parses the flags into a
 // ConvertSource and BuildOptions and prints the ConvertReport (text on stderr, or exactly one
 // JSON object on stdout); the pipeline itself is the library's convert() (octiso/convert.h).
+#include <chrono>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+
+#include <unistd.h>
 
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
@@ -47,6 +51,10 @@ constexpr const char* kUsage =
     "  --nan-as V                replace NaN and +-inf by V (default: refuse non-finite input)\n"
     "  --steps A:B               a series from a printf pattern, steps A..B inclusive\n"
     "  --synthetic NAME:N        sphere marschner-lobb sponge noise plume mixing plume-series sparse-spheres\n"
+    "  --memory BYTES            memory budget (suffix K, M or G; default a quarter of physical memory):\n"
+    "                            raw and NIfTI input is converted out of core, slab by slab, within it;\n"
+    "                            the file is the same as the in-memory one\n"
+    "  --in-memory               the whole-array path whatever the input's size (benchmarks)\n"
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
     "  --json                    one JSON object on stdout; the text report goes to stderr\n"
     "  --version, -h/--help\n";
@@ -66,6 +74,52 @@ std::array<double, 3> positive_vec3(const std::string& text, const std::string& 
     for (double c : v)
         if (!(c > 0)) throw Error(flag, "expected three positive numbers, found '" + text + "'");
     return v;
+}
+
+/// Progress of an out-of-core conversion on stderr (issue 13): only when stderr is a terminal,
+/// not with --json, and only once the conversion has run for a second; redrawn at most 4 times a
+/// second on one line, which finish() ends. Bytes are the input's voxel bytes.
+class ProgressLine {
+public:
+    explicit ProgressLine(bool wanted) : wanted_(wanted && ::isatty(STDERR_FILENO)), t0_(Clock::now()) {}
+    void update(uint64_t done, uint64_t all, uint64_t voxels) {
+        if (!wanted_) return;
+        const auto now = Clock::now();
+        const double t = std::chrono::duration<double>(now - t0_).count();
+        if (t < 1.0 || (shown_ && std::chrono::duration<double>(now - last_).count() < 0.25)) return;
+        last_ = now;
+        shown_ = true;
+        const double rate = double(done) / t;
+        const double eta = rate > 0 ? double(all - std::min(done, all)) / rate : 0;
+        std::fprintf(stderr, "\r  read %.0f of %.0f MiB, %.1f Mvoxel/s, ETA %.0f s   ", double(done) / 1048576.0,
+                     double(all) / 1048576.0, double(voxels) / t / 1e6, eta);
+        std::fflush(stderr);
+    }
+    void finish() {
+        if (shown_) std::fputc('\n', stderr);
+        shown_ = false;
+    }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    bool wanted_;
+    bool shown_ = false;
+    Clock::time_point t0_, last_;
+};
+
+/// --memory BYTES: a positive integer with an optional K, M or G suffix (powers of 1024).
+uint64_t parse_memory(const std::string& text) {
+    uint64_t scale = 1;
+    std::string digits = text;
+    if (!digits.empty()) {
+        const char last = char(std::toupper(static_cast<unsigned char>(digits.back())));
+        if (last == 'K' || last == 'M' || last == 'G') {
+            scale = last == 'K' ? (1ull << 10) : last == 'M' ? (1ull << 20) : (1ull << 30);
+            digits.pop_back();
+        }
+    }
+    const auto n = uint64_t(cli::parse_int(digits, "--memory", 1, (1LL << 62) / (1LL << 30)));
+    return n * scale;
 }
 
 /// The flags that say where the steps come from, in the order they are checked (so that of
@@ -161,6 +215,8 @@ void write_json(std::ostream& os, const ConvertReport& r, const std::optional<st
     j.field("build_seconds", r.build_seconds).field("total_seconds", r.total_seconds);
     j.field("mvoxels_per_second", r.mvoxels_per_second());
     j.field("peak_rss_bytes", r.peak_rss_bytes).field("threads", r.threads);
+    j.field("streamed", r.streamed).field("memory_budget", r.memory_budget).field("piece_side", r.piece_side);
+    j.field("bytes_read", r.bytes_read).field("spilled_bytes", r.spilled_bytes);
     j.end_object();
     os << "\n";
 }
@@ -186,6 +242,9 @@ void write_human(std::ostream& os, const ConvertReport& r, const std::optional<s
         os << "  note: the octree is larger than its input (" << mib(r.file_bytes) << " > " << mib(r.input_bytes)
            << "): too little of the data is uniform to merge. --iso-range LO,HI (exact for every isovalue inside it)"
               " or --tolerance EPS (lossy, error <= EPS) makes it smaller\n";
+    if (r.streamed)
+        os << "  out of core: --memory " << mib(r.memory_budget) << ", pieces of " << r.piece_side << "^3, read "
+           << mib(r.bytes_read) << ", spilled " << mib(r.spilled_bytes) << "\n";
 }
 
 /// --synthetic sparse-spheres:N (f32, N^3, N >= 64): built directly as an octree, no dense array
@@ -235,12 +294,24 @@ int run(std::vector<std::string>& argv) {
     }
     if (const auto v = args.value("--nan-as")) opt.nan_as = cli::parse_double(*v, "--nan-as");
     if (const auto t = args.value("--threads")) opt.threads = int(cli::parse_int(*t, "--threads", 0, 4096));   // 0: all cores
+    MemoryOptions memory;
+    if (const auto m = args.value("--memory")) memory.budget = parse_memory(*m);
+    memory.force_in_memory = args.flag("--in-memory");
     const ConvertSource src = parse_source(args);
     args.finish();
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
     cli::check_output_file(*out, "-o");   // before the work, naming the user's path
 
-    const ConvertReport report = octiso::convert(src, *out, opt);
+    ProgressLine progress(!json);
+    memory.on_progress = [&](uint64_t done, uint64_t all, uint64_t voxels) { progress.update(done, all, voxels); };
+    ConvertReport report;
+    try {
+        report = octiso::convert(src, *out, opt, memory);
+    } catch (...) {
+        progress.finish();   // the error line starts on a line of its own
+        throw;
+    }
+    progress.finish();
     const auto range = stored_range(report.output);
     write_human(std::cerr, report, range);
     if (json) write_json(std::cout, report, range);

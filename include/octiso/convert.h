@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,8 @@ public:
     /// Opens (or generates) step i, placement overrides applied. Throws Error naming the file.
     /// Not for sparse-spheres, which has no dense volume.
     LoadedVolume load(uint32_t i) const;
+    /// The raw and placement flags every file step is opened with.
+    const RawOptions& raw_options() const { return raw_; }
 
 private:
     ConvertSource() = default;
@@ -58,6 +61,25 @@ private:
     uint32_t sparse_n_ = 0;
     RawOptions raw_;
 };
+
+/// How much memory a conversion may use (issue 13, octiso-convert --memory).
+struct MemoryOptions {
+    /// --memory BYTES: the budget. Set: streamable input (raw files) is converted out of core,
+    /// slab by slab, its node arrays spilled to temporaries beside the output once they outgrow
+    /// the budget; input that must be read whole (VTK formats) is refused if it exceeds it.
+    /// Unset: default_memory_budget(), and input is converted in memory when about twice its size
+    /// fits that budget, out of core otherwise. Either way the file written is the same, byte for byte.
+    std::optional<uint64_t> budget;
+    uint32_t piece_side = 0;   ///< forces the out-of-core pieces' side (a power of two >= 4; tests); 0: from the budget
+    bool force_streaming = false;   ///< out of core even without a budget (tests)
+    bool force_in_memory = false;   ///< --in-memory: the whole-array path whatever the size (benchmarks)
+    /// Called from the converting thread after each slab with (bytes read so far, bytes in all, voxels
+    /// built so far); for progress reports. Not called on the in-memory path.
+    std::function<void(uint64_t, uint64_t, uint64_t)> on_progress;
+};
+
+/// A quarter of the machine's physical memory (the default of --memory).
+uint64_t default_memory_budget();
 
 /// What one step cost and gave.
 struct ConvertStepReport {
@@ -89,6 +111,11 @@ struct ConvertReport {
     double total_seconds = 0;    ///< the whole call, reading and writing included
     uint64_t peak_rss_bytes = 0; ///< the process's high-water mark when the file was finished
     int threads = 0;             ///< TBB's parallelism limit during the call
+    bool streamed = false;       ///< converted out of core (MemoryOptions)
+    uint64_t memory_budget = 0;  ///< the budget that applied
+    uint32_t piece_side = 0;     ///< the out-of-core pieces' side, when streamed
+    uint64_t bytes_read = 0;     ///< from the input files, when streamed
+    uint64_t spilled_bytes = 0;  ///< node bytes that went through temporary files, when streamed
 
     double ratio() const { return input_bytes ? double(file_bytes) / double(input_bytes) : 0.0; }
     double mvoxels_per_second() const {
@@ -102,6 +129,9 @@ struct ConvertReport {
 /// Error(step file, ...) (exit 2) and writes nothing. Until the file is finished only a
 /// temporary sibling exists, removed on any error. options.threads > 0 limits all TBB work
 /// of the process to that many threads for the duration of the call (tbb::global_control).
-ConvertReport convert(const ConvertSource& source, const std::string& output, const BuildOptions& options);
+/// `memory` chooses in-memory or out-of-core conversion (see MemoryOptions); a budget too small
+/// for one slab is Error(input, "out of memory: ...") (exit 2) before the output is created.
+ConvertReport convert(const ConvertSource& source, const std::string& output, const BuildOptions& options,
+                      const MemoryOptions& memory = {});
 
 }  // namespace octiso

@@ -38,6 +38,16 @@ public:
     OctWriter& operator=(const OctWriter&) = delete;
 
     template <typename T> void add_step(const Octree<T>& octree);
+
+    /// A step streamed section by section (the out-of-core converter, whose arrays never sit in
+    /// memory whole): for d = 0 .. dmax-1 in order, begin_section(d, count), append_records() with
+    /// exactly count records (InteriorNode<T>, Caps at dmax-1) in as many calls as convenient, then
+    /// end_section(); the step counts once its caps section ends. The checksum is computed as the
+    /// bytes pass. The caller validates the records (it alone sees them all, one chunk at a time).
+    void begin_section(int depth, uint64_t count);
+    void append_records(const void* data, uint64_t bytes);
+    void end_section();
+
     void finish();
     uint64_t bytes_written() const;
 

@@ -2,13 +2,20 @@
 // first, 2. build and stream the steps one at a time into one OctWriter, 3. measure. Building
 // goes through AnyOctree, so no scalar type is named here; sparse-spheres takes its own short
 // path because it never has a dense volume.
+#include <algorithm>
 #include <chrono>
 #include <optional>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <tbb/global_control.h>
 
 #include "convert/same_grid.h"
+#include "convert/stream_build.h"
+#include "io/header_check.h"
+#include "io/nifti_header.h"
+#include "io/volume_stream.h"
 #include "octiso/any_octree.h"
 #include "octiso/convert.h"
 #include "octiso/output_guard.h"
@@ -60,9 +67,101 @@ ConvertReport convert_sparse_spheres(const ConvertSource& source, const std::str
     return r;
 }
 
+convert_detail::GridOfStep grid_of(const VolumeStream& s) {
+    return {s.source(), s.format(), s.type(), s.dims(), s.placement(), s.bytes()};
+}
+
+/// Out of core (stream_build.h): every step opened as a stream and checked against the first,
+/// the plan checked against the budget, then the steps built and streamed one at a time.
+ConvertReport convert_streamed(const ConvertSource& source, const std::string& output, const BuildOptions& options,
+                               const MemoryOptions& memory, uint64_t budget, Clock::time_point t_start) {
+    using convert_detail::GridOfStep;
+    const uint32_t n_files = source.step_count();
+    std::unique_ptr<VolumeStream> step0 = open_volume_stream(source.step_path(0), source.raw_options());
+    const GridOfStep first = grid_of(*step0);
+    for (uint32_t i = 1; i < n_files; ++i) {
+        const std::unique_ptr<VolumeStream> s = open_volume_stream(source.step_path(i), source.raw_options());
+        convert_detail::check_same_grid(first, grid_of(*s));
+        if (s->time_steps() != 1) throw Error(s->source(), "a 4-D file is a series by itself; list only 3-D files");
+    }
+    // A 4-D NIfTI is a time series in one file: its volumes are the steps, read from one stream.
+    const uint32_t per_file = step0->time_steps();
+    if (per_file != 1 && n_files != 1) throw Error(step0->source(), "a 4-D file is a series by itself; list only 3-D files");
+    const uint32_t n_steps = n_files * per_file;
+    const convert_detail::StreamPlan plan = convert_detail::plan_stream(first.dims, first.type, options, budget, memory.piece_side, first.source);
+
+    OctInfo info;
+    info.type = first.type;
+    info.dims = first.dims;
+    info.placement = first.placement;
+    info.dmax = dmax_for(first.dims);
+    info.iso_range = options.iso_range;
+    info.tolerance = options.tolerance;
+
+    ConvertReport r;
+    BuildOptions opt = options;
+    OctWriter writer(output, info);
+    const uint64_t all_bytes = first.bytes * n_steps;
+    const uint64_t layer_voxels = uint64_t(first.dims.x) * first.dims.y;
+    for (uint32_t i = 0; i < n_steps; ++i) {
+        std::unique_ptr<VolumeStream> opened;
+        if (per_file == 1) opened = i == 0 ? std::move(step0) : open_volume_stream(source.step_path(i), source.raw_options());
+        else if (i > 0) step0->start_next_step();
+        VolumeStream* s = per_file == 1 ? opened.get() : step0.get();
+        if (i > 0 && per_file == 1) convert_detail::check_same_grid(first, grid_of(*s));   // a file may have changed since
+        opt.source_name = s->source();
+        const uint64_t done_before = first.bytes * i;
+        std::function<void(uint32_t)> on_layers;
+        if (memory.on_progress)
+            on_layers = [&](uint32_t layers) {
+                memory.on_progress(done_before + layers * s->layer_bytes(), all_bytes,
+                                   (uint64_t(i) * first.dims.z + layers) * layer_voxels);
+            };
+        const convert_detail::StreamStepResult res =
+            convert_detail::stream_build_step(*s, opt, plan, writer, output, on_layers);
+        r.build_seconds += res.build_seconds;
+        r.spilled_bytes += res.spilled_bytes;
+        if (per_file == 1 || i + 1 == n_steps) r.bytes_read += s->file_bytes_read();
+        add_sizes(r.total, res.sizes);
+        r.per_step.push_back({s->source(), res.sizes, res.build_seconds});
+    }
+    writer.finish();
+
+    struct stat st {};
+    r.file_bytes = ::stat(output.c_str(), &st) == 0 ? uint64_t(st.st_size) : writer.bytes_written();
+    r.peak_rss_bytes = peak_rss_bytes();
+    r.input = source.name();
+    r.output = output;
+    r.format = first.format;
+    r.type = first.type;
+    r.dims = first.dims;
+    r.placement = first.placement;
+    r.dmax = info.dmax;
+    r.steps = n_steps;
+    r.iso_range = options.iso_range;
+    r.tolerance = options.tolerance;
+    r.input_bytes = all_bytes;
+    r.threads = active_threads();
+    r.streamed = true;
+    r.memory_budget = budget;
+    r.piece_side = plan.piece_side;
+    r.total_seconds = seconds_since(t_start);
+    return r;
+}
+
 }  // namespace
 
-ConvertReport convert(const ConvertSource& source, const std::string& output, const BuildOptions& options) {
+uint64_t default_memory_budget() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+    uint64_t budget = pages > 0 && page > 0 ? uint64_t(pages) / 4 * uint64_t(page) : uint64_t(1) << 30;
+    // Under ulimit -v the address space is the tighter limit: keep half of it for everything else.
+    struct rlimit as {};
+    if (::getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY) budget = std::min<uint64_t>(budget, as.rlim_cur / 2);
+    return budget;
+}
+
+ConvertReport convert(const ConvertSource& source, const std::string& output, const BuildOptions& options,
+                      const MemoryOptions& memory) {
     using convert_detail::check_same_grid;
     using convert_detail::GridOfStep;
     const Clock::time_point t_start = Clock::now();
@@ -75,11 +174,51 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     std::optional<tbb::global_control> limit;   // reading, generating and building alike
     if (options.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(options.threads));
 
+    // 0. In memory or out of core. The in-memory build holds the input and the whole octree, about
+    //    twice the input (BENCHMARKS.md, compression: 1.1x of input + output).
+    const uint64_t budget = memory.budget.value_or(default_memory_budget());
+    if (memory.budget && *memory.budget == 0) throw Error("--memory", "must be > 0");
+    if (memory.force_in_memory && (memory.budget || memory.force_streaming))
+        throw Error("--in-memory", "does not combine with --memory");
+    const bool streamable =
+        !memory.force_in_memory && !source.is_synthetic() && is_streamable(source.step_path(0), source.raw_options());
+    if (streamable) {
+        // Bad dims are reported by either reader with the same words; let the in-memory one do it.
+        const bool nifti = detect_volume_format(source.step_path(0)) == VolumeFormat::nifti && !source.raw_options().dims;
+        std::optional<io::NiftiHeader> header;
+        if (nifti) header = io::read_nifti_header(source.step_path(0));
+        const Dims d = nifti ? header->dims : *source.raw_options().dims;
+        const ScalarType t = nifti ? header->type : *source.raw_options().type;
+        const bool valid = d.x && d.y && d.z && d.max_extent() <= Dims::kMaxExtent &&
+                           d.voxels() / d.x / d.y == d.z && d.voxels() <= UINT64_MAX / 8;
+        const bool fits = !valid || d.voxels() * scalar_type_bytes(t) <= budget / 2;
+        // VTK reads a 4-D NIfTI as components, which octiso refuses: only the stream reads its steps.
+        const bool four_d = nifti && header->time_steps > 1;
+        if (memory.budget || memory.force_streaming || !fits || four_d)
+            return convert_streamed(source, output, options, memory, budget, t_start);
+    }
+
     // 1. Open every step and compare it with the first before anything is written. For raw
     //    input this only maps files; other formats are read once here and once when converted.
     const uint32_t n_steps = source.step_count();
+    // Input VTK must read whole is refused over an explicit budget before VTK allocates it, from
+    // the header's declaration (header_check.h), and again after reading if the header said nothing.
+    auto too_big_for_budget = [&](const std::string& path, VolumeFormat format, uint64_t bytes) {
+        return Error(path, std::string(volume_format_name(format)) + " input is read whole (through VTK): its " +
+                               std::to_string(bytes) + " voxel bytes exceed --memory " + std::to_string(*memory.budget) +
+                               " (convert it to raw to stream it)");
+    };
+    if (memory.budget && !source.is_synthetic() && !source.raw_options().dims && !source.raw_options().type) {
+        const VolumeFormat f = detect_volume_format(source.step_path(0));
+        if (f != VolumeFormat::raw && f != VolumeFormat::nifti) {
+            const uint64_t declared = io::check_declared_size(source.step_path(0), f);
+            if (declared > *memory.budget) throw too_big_for_budget(source.step_path(0), f, declared);
+        }
+    }
     std::optional<LoadedVolume> step0 = source.load(0);
     const GridOfStep first(*step0);
+    if (memory.budget && !source.is_synthetic() && first.bytes > *memory.budget)
+        throw too_big_for_budget(first.source, first.format, first.bytes);
     if (!source.is_synthetic())
         for (uint32_t i = 1; i < n_steps; ++i) check_same_grid(first, source.load(i));
 
@@ -128,6 +267,7 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     r.tolerance = options.tolerance;
     r.input_bytes = first.bytes * n_steps;
     r.threads = active_threads();
+    r.memory_budget = budget;
     r.total_seconds = seconds_since(t_start);
     return r;
 }

@@ -13,16 +13,18 @@ std::string dims_text(Dims d) { return std::to_string(d.x) + "x" + std::to_strin
 GridOfStep::GridOfStep(const LoadedVolume& v)
     : source(v.source()), format(v.format()), type(v.type()), dims(v.dims()), placement(v.placement()), bytes(v.bytes()) {}
 
-void check_same_grid(const GridOfStep& first, const LoadedVolume& v) {
-    if (v.dims() != first.dims)
-        throw Error(v.source(), "dims differ from the first step (expected " + dims_text(first.dims) + ", found " +
-                                    dims_text(v.dims()) + ")");
-    if (v.type() != first.type)
-        throw Error(v.source(), "scalar type differs from the first step (expected " +
+void check_same_grid(const GridOfStep& first, const LoadedVolume& v) { check_same_grid(first, GridOfStep(v)); }
+
+void check_same_grid(const GridOfStep& first, const GridOfStep& v) {
+    if (v.dims != first.dims)
+        throw Error(v.source, "dims differ from the first step (expected " + dims_text(first.dims) + ", found " +
+                                    dims_text(v.dims) + ")");
+    if (v.type != first.type)
+        throw Error(v.source, "scalar type differs from the first step (expected " +
                                     std::string(scalar_type_name(first.type)) + ", found " +
-                                    std::string(scalar_type_name(v.type())) + ")");
-    if (v.placement().spacing != first.placement.spacing || v.placement().origin != first.placement.origin)
-        throw Error(v.source(), "spacing or origin differs from the first step (override both with --spacing/--origin)");
+                                    std::string(scalar_type_name(v.type)) + ")");
+    if (v.placement.spacing != first.placement.spacing || v.placement.origin != first.placement.origin)
+        throw Error(v.source, "spacing or origin differs from the first step (override both with --spacing/--origin)");
 }
 
 }  // namespace octiso::convert_detail

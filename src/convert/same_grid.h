@@ -19,10 +19,14 @@ struct GridOfStep {
     Placement placement;
     uint64_t bytes = 0;   ///< dense voxel bytes
     explicit GridOfStep(const LoadedVolume& v);
+    GridOfStep(std::string source, VolumeFormat format, ScalarType type, Dims dims, Placement placement, uint64_t bytes)
+        : source(std::move(source)), format(format), type(type), dims(dims), placement(placement), bytes(bytes) {}
 };
 
 /// Throws Error(step.source(), ...) (bad input, exit 2) naming the first field that differs
 /// from step 0, with both values for dims and type.
 void check_same_grid(const GridOfStep& first, const LoadedVolume& step);
+/// The same rule for a step described by `step` (a streamed step, whose voxels are not loaded).
+void check_same_grid(const GridOfStep& first, const GridOfStep& step);
 
 }  // namespace octiso::convert_detail

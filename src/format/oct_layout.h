@@ -137,4 +137,20 @@ inline constexpr uint64_t align_up(uint64_t x) { return (x + kSectionAlign - 1) 
 /// XXH3-64 (seed 0) of a byte range; defined in validate.cpp so only one file includes xxhash.h.
 uint64_t checksum(const void* data, size_t bytes);
 
+/// The same XXH3-64 (seed 0) over bytes handed in pieces, for sections streamed from disk
+/// (the out-of-core builder): update() in order, then digest() equals checksum() of them all.
+class ChecksumStream {
+public:
+    ChecksumStream();
+    ~ChecksumStream();
+    ChecksumStream(const ChecksumStream&) = delete;
+    ChecksumStream& operator=(const ChecksumStream&) = delete;
+    void reset();
+    void update(const void* data, size_t bytes);
+    uint64_t digest() const;
+
+private:
+    void* state_;   // XXH3_state_t, opaque so that only validate.cpp includes xxhash.h
+};
+
 }  // namespace octiso::format

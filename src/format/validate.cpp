@@ -4,6 +4,7 @@
 #include "format/validate.h"
 
 #include <algorithm>
+#include <new>
 #include <bit>
 #include <cstdio>
 #include <optional>
@@ -17,6 +18,17 @@
 namespace octiso::format {
 
 uint64_t checksum(const void* data, size_t bytes) { return XXH3_64bits(data, bytes); }
+
+ChecksumStream::ChecksumStream() : state_(XXH3_createState()) {
+    if (!state_) throw std::bad_alloc();
+    reset();
+}
+ChecksumStream::~ChecksumStream() { XXH3_freeState(static_cast<XXH3_state_t*>(state_)); }
+void ChecksumStream::reset() { XXH3_64bits_reset(static_cast<XXH3_state_t*>(state_)); }
+void ChecksumStream::update(const void* data, size_t bytes) {
+    if (bytes != 0) XXH3_64bits_update(static_cast<XXH3_state_t*>(state_), data, bytes);
+}
+uint64_t ChecksumStream::digest() const { return XXH3_64bits_digest(static_cast<const XXH3_state_t*>(state_)); }
 
 namespace {
 

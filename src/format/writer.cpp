@@ -28,6 +28,12 @@ struct OctWriter::Impl {
     std::vector<SectionEntry> table;
     bool broken = false;               // a write failed: finish() must not publish the file
     bool finished = false;
+    // The section being streamed (begin_section .. end_section); open_depth < 0 when none.
+    int open_depth = -1;
+    int next_depth = 0;                // the depth the next streamed section must have
+    SectionEntry open_entry{};
+    uint64_t open_written = 0;
+    format::ChecksumStream open_checksum;
 
     Impl(std::string path, const OctInfo& i) : info(i), out(std::move(path)) {}
     ~Impl() {
@@ -96,6 +102,7 @@ template <typename T> void OctWriter::add_step(const Octree<T>& octree) {
     const std::string& p = m.out.path();
     if (m.finished) throw Error(p, "add_step() after finish()", ErrorKind::Other);
     if (m.broken) throw Error(p, "an earlier write failed", ErrorKind::Other);
+    if (m.open_depth >= 0 || m.next_depth != 0) throw Error(p, "add_step() inside a streamed step", ErrorKind::Other);
     if (scalar_type_of<T>() != m.info.type)
         throw Error(p, "step of type " + std::string(scalar_type_name(scalar_type_of<T>())) + " added to a file of type " +
                            std::string(scalar_type_name(m.info.type)), ErrorKind::Other);
@@ -118,12 +125,69 @@ template <typename T> void OctWriter::add_step(const Octree<T>& octree) {
     m.info.step_count = step + 1;
 }
 
+void OctWriter::begin_section(int depth, uint64_t count) {
+    Impl& m = *impl_;
+    const std::string& p = m.out.path();
+    if (m.finished) throw Error(p, "begin_section() after finish()", ErrorKind::Other);
+    if (m.broken) throw Error(p, "an earlier write failed", ErrorKind::Other);
+    if (m.open_depth >= 0 || depth != m.next_depth || depth >= m.info.dmax)
+        throw Error(p, "streamed section out of order (expected depth " + std::to_string(m.next_depth) + ", found " +
+                           std::to_string(depth) + ")", ErrorKind::Other);
+    if (depth == 0 && m.info.step_count == UINT32_MAX) throw Error(p, "too many time steps", ErrorKind::Other);
+    const bool caps = depth == m.info.dmax - 1;
+    const uint64_t scalar = scalar_type_bytes(m.info.type);
+    const uint64_t record = caps ? format::cap_record_bytes(scalar) : format::interior_record_bytes(scalar);
+    if (count > (uint64_t(1) << 40))   // far beyond 2^32 nodes a depth, so count * record cannot wrap
+        throw Error(p, "section of " + std::to_string(count) + " records is too large", ErrorKind::Other);
+    m.pad_to_alignment();
+    SectionEntry& e = m.open_entry;
+    e = SectionEntry{};
+    e.kind = uint32_t(caps ? format::SectionKind::Caps : format::SectionKind::Interior);
+    e.step = m.info.step_count;
+    e.depth = uint32_t(depth);
+    e.record_bytes = uint32_t(record);
+    e.offset = m.pos;
+    e.count = count;
+    e.bytes = count * record;
+    m.open_written = 0;
+    m.open_checksum.reset();
+    m.open_depth = depth;
+}
+
+void OctWriter::append_records(const void* data, uint64_t bytes) {
+    Impl& m = *impl_;
+    if (m.open_depth < 0) throw Error(m.out.path(), "append_records() outside a section", ErrorKind::Other);
+    if (bytes > m.open_entry.bytes - m.open_written)
+        throw Error(m.out.path(), "streamed section overruns its count at depth " + std::to_string(m.open_depth),
+                    ErrorKind::Other);
+    m.open_checksum.update(data, size_t(bytes));
+    m.write(data, bytes);
+    m.open_written += bytes;
+}
+
+void OctWriter::end_section() {
+    Impl& m = *impl_;
+    const std::string& p = m.out.path();
+    if (m.open_depth < 0) throw Error(p, "end_section() outside a section", ErrorKind::Other);
+    if (m.open_written != m.open_entry.bytes)
+        throw Error(p, "streamed section at depth " + std::to_string(m.open_depth) + " holds " +
+                           std::to_string(m.open_written) + " bytes (expected " + std::to_string(m.open_entry.bytes) + ")",
+                    ErrorKind::Other);
+    m.open_entry.checksum = m.open_checksum.digest();
+    m.table.push_back(m.open_entry);
+    const bool caps = m.open_depth == m.info.dmax - 1;
+    m.open_depth = -1;
+    m.next_depth = caps ? 0 : m.next_depth + 1;
+    if (caps) m.info.step_count += 1;
+}
+
 void OctWriter::finish() {
     Impl& m = *impl_;
     const std::string& p = m.out.path();
     if (m.finished) throw Error(p, "finish() called twice", ErrorKind::Other);
     if (m.broken) throw Error(p, "an earlier write failed", ErrorKind::Other);
     if (m.info.step_count == 0) throw Error(p, "no time steps were added", ErrorKind::Other);
+    if (m.open_depth >= 0 || m.next_depth != 0) throw Error(p, "a streamed step is unfinished", ErrorKind::Other);
 
     m.pad_to_alignment();
     FileHeader h{};

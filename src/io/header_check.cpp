@@ -114,7 +114,7 @@ int nifti_type_bytes(int datatype) {
     }
 }
 
-void check_nifti(const std::string& path) {
+uint64_t check_nifti(const std::string& path) {
     const bool gz = lower(path).size() >= 3 && lower(path).substr(path.size() - 3) == ".gz";
     unsigned char h[540] = {};
     size_t n = 0;
@@ -133,6 +133,7 @@ void check_nifti(const std::string& path) {
     const uint64_t bytes = file_size(path);
     check_nifti_header(h, n, gz ? (bytes > UINT64_MAX / kDeflateMaxRatio ? UINT64_MAX : bytes * kDeflateMaxRatio) : bytes,
                        !gz, path);
+    return 0;   // NIfTI is streamed (nifti_stream.cpp); its size is the parsed header's business
 }
 
 // ---- NRRD ----------------------------------------------------------------------------------
@@ -150,7 +151,7 @@ int nrrd_type_bytes(const std::string& t) {
     return it == types.end() ? 0 : it->second;
 }
 
-void check_nrrd(const std::string& path) {
+uint64_t check_nrrd(const std::string& path) {
     const std::string head = head_of(path);
     size_t end = head.find("\n\n");
     size_t skip = 2;
@@ -168,7 +169,7 @@ void check_nrrd(const std::string& path) {
         key.erase(std::remove(key.begin(), key.end(), ' '), key.end());
         field[key] = trim(value);
     }
-    if (!field.count("sizes") || !field.count("type")) return;   // VTK will say what is missing
+    if (!field.count("sizes") || !field.count("type")) return 0;   // VTK will say what is missing
     const int tb = nrrd_type_bytes(field["type"]);
     if (tb == 0) throw Error(path, "NRRD type '" + field["type"] + "' is not supported");
     const std::vector<uint64_t> sizes = parse_sizes(field["sizes"], "NRRD sizes", path);
@@ -179,12 +180,12 @@ void check_nrrd(const std::string& path) {
     if (data.empty()) {
         if (end == std::string::npos) {
             if (head.size() < kHeaderLimit) throw Error(path, "NRRD header has no blank line before the data");
-            return;
+            return 0;
         }
         available = file_size(path) - uint64_t(end + skip);
     } else {
         if (data.find('%') != std::string::npos || data.rfind("LIST", 0) == 0 || data.find(' ') != std::string::npos)
-            return;   // a list or pattern of files: left to VTK
+            return 0;   // a list or pattern of files: left to VTK
         if (data[0] != '/') data = folder_of(path) + data;
         struct stat st {};
         if (::stat(data.c_str(), &st) != 0) throw Error(path, "NRRD data file '" + data + "' does not exist");
@@ -199,6 +200,7 @@ void check_nrrd(const std::string& path) {
     else if (enc == "hex") check_bound(path, "NRRD header", declared * 2, available, false);
     else if (enc == "ascii" || enc == "text" || enc == "txt")
         check_bound(path, "NRRD header", declared / uint64_t(tb) * 2 - 1, available, false);
+    return declared;
 }
 
 // ---- legacy VTK ----------------------------------------------------------------------------
@@ -211,7 +213,7 @@ int vtk_type_bytes(const std::string& t) {
     return it == types.end() ? 0 : it->second;
 }
 
-void check_legacy_vtk(const std::string& path) {
+uint64_t check_legacy_vtk(const std::string& path) {
     const std::string head = head_of(path);
     std::istringstream in(head);
     std::string line;
@@ -232,7 +234,7 @@ void check_legacy_vtk(const std::string& path) {
         } else if (key == "point_data") {
             w >> point_data;
         } else if (key == "cell_data" && point_data == 0) {
-            return;   // cell data first: rare; VTK and the later checks handle it
+            return 0;   // cell data first: rare; VTK and the later checks handle it
         } else if (key == "scalars" && point_data > 0) {
             std::string name, type;
             w >> name >> type;
@@ -246,14 +248,15 @@ void check_legacy_vtk(const std::string& path) {
                     throw Error(path, "legacy VTK header: DIMENSIONS give " + num(n) + " points but POINT_DATA says " + num(point_data));
             }
             const std::streamoff at = in.tellg();
-            if (at < 0) return;
+            if (at < 0) return 0;
             const uint64_t declared = product({point_data, components}, uint64_t(tb), path);
             const uint64_t available = file_size(path) - uint64_t(at);
             if (binary) check_bound(path, "legacy VTK header", declared, available, false);
             else check_bound(path, "legacy VTK header", declared / uint64_t(tb) * 2 - 1, available, false);
-            return;
+            return declared;
         }
     }
+    return 0;
 }
 
 // ---- MetaImage -----------------------------------------------------------------------------
@@ -266,7 +269,7 @@ int met_type_bytes(const std::string& t) {
     return it == types.end() ? 0 : it->second;
 }
 
-void check_meta_image(const std::string& path) {
+uint64_t check_meta_image(const std::string& path) {
     const std::string head = head_of(path);
     std::istringstream in(head);
     std::string line;
@@ -282,7 +285,7 @@ void check_meta_image(const std::string& path) {
             break;
         }
     }
-    if (data_at < 0 || !field.count("DimSize") || !field.count("ElementType")) return;   // VTK reports it
+    if (data_at < 0 || !field.count("DimSize") || !field.count("ElementType")) return 0;   // VTK reports it
     const int tb = met_type_bytes(field["ElementType"]);
     if (tb == 0) throw Error(path, "MetaImage ElementType '" + field["ElementType"] + "' is not supported");
     std::vector<uint64_t> sizes = parse_sizes(field["DimSize"], "MetaImage DimSize", path);
@@ -294,7 +297,7 @@ void check_meta_image(const std::string& path) {
     if (data == "LOCAL" || data == "Local" || data == "local") {
         available = file_size(path) - uint64_t(data_at);
     } else {
-        if (data.find('%') != std::string::npos || data.rfind("LIST", 0) == 0 || data.find(' ') != std::string::npos) return;
+        if (data.find('%') != std::string::npos || data.rfind("LIST", 0) == 0 || data.find(' ') != std::string::npos) return 0;
         if (data[0] != '/') data = folder_of(path) + data;
         struct stat st {};
         if (::stat(data.c_str(), &st) != 0) throw Error(path, "MetaImage data file '" + data + "' does not exist");
@@ -305,6 +308,7 @@ void check_meta_image(const std::string& path) {
         available = b > available ? 0 : available - b;
     }
     check_bound(path, "MetaImage header", declared, available, compressed);
+    return declared;
 }
 
 }  // namespace
@@ -351,13 +355,13 @@ void check_nifti_header(const unsigned char* h, size_t n, uint64_t bound, bool e
     if (declared > available) too_big(path, "NIfTI header", declared, available, !exact);
 }
 
-void check_declared_size(const std::string& path, VolumeFormat format) {
+uint64_t check_declared_size(const std::string& path, VolumeFormat format) {
     switch (format) {
-        case VolumeFormat::nifti: check_nifti(path); return;
-        case VolumeFormat::nrrd: check_nrrd(path); return;
-        case VolumeFormat::legacy_vtk: check_legacy_vtk(path); return;
-        case VolumeFormat::meta_image: check_meta_image(path); return;
-        default: return;
+        case VolumeFormat::nifti: return check_nifti(path);
+        case VolumeFormat::nrrd: return check_nrrd(path);
+        case VolumeFormat::legacy_vtk: return check_legacy_vtk(path);
+        case VolumeFormat::meta_image: return check_meta_image(path);
+        default: return 0;
     }
 }
 

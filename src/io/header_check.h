@@ -17,7 +17,9 @@ namespace octiso::io {
 
 /// Throws Error(path, ...) (bad input) if the header of `path` (format `format`) declares
 /// something octiso cannot read or more voxel bytes than the file (or its data file) holds.
-void check_declared_size(const std::string& path, VolumeFormat format);
+/// Returns the voxel bytes the header declares (what VTK will allocate), 0 where it was not
+/// parsed (NIfTI, file lists and patterns, layouts left to VTK).
+uint64_t check_declared_size(const std::string& path, VolumeFormat format);
 
 /// The NIfTI-1/-2 header check on bytes already read: `header` holds the first `n` bytes of the
 /// (decompressed) file, `data_bytes_bound` the most bytes the file can hold after vox_offset's

@@ -11,6 +11,8 @@
 #include <unistd.h>
 
 #include "io/input_file.h"
+#include "io/nifti_header.h"
+#include "io/volume_stream.h"
 #include "octiso/reader.h"
 
 namespace octiso {
@@ -87,13 +89,15 @@ VolumeFormat detect_volume_format(const std::string& path) {
     return VolumeFormat::raw;
 }
 
-LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
+namespace {
+
+// The format of `path` under `options`, with the flag checks every reader shares:
+// 1. An extension names the format outright; raw-only flags then mean a confused command line.
+// 2. Magic bytes claim an extension-less file, unless --dims/--type say it is raw.
+// 3. Anything else is raw (CONVENTIONS 3), and needs --dims and --type.
+VolumeFormat choose_format(const std::string& path, const RawOptions& options) {
     io::check_input_file(path);
     const bool raw_flags = options.dims || options.type;
-
-    // 1. An extension names the format outright; raw-only flags then mean a confused command line.
-    // 2. Magic bytes claim an extension-less file, unless --dims/--type say it is raw.
-    // 3. Anything else is raw (CONVENTIONS 3).
     VolumeFormat format = VolumeFormat::raw;
     if (auto f = format_from_extension(path)) {
         format = *f;
@@ -108,29 +112,62 @@ LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
             throw Error(path, "looks like NIfTI, but VTK's NIfTI reader needs a .nii or .nii.gz name "
                               "(or give --dims and --type to read it as raw)");
     }
-
-    LoadedVolume volume;
     if (format == VolumeFormat::raw) {
         if (!options.dims)
             throw Error("--dims", "raw input '" + path + "' needs --dims NX,NY,NZ (no other format claims the file)");
         if (!options.type)
             throw Error("--type", "raw input '" + path + "' needs --type u8|i8|u16|i16|u32|i32|f32|f64");
-        volume = read_raw(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
-                          options.offset.value_or(0));
-    } else {
-        if (options.endian || options.offset)
-            throw Error(options.endian ? "--endian" : "--offset",
-                        "applies only to raw input, and '" + path + "' is read as " +
-                            std::string(volume_format_name(format)));
-        volume = read_vtk(path, format);
+    } else if (options.endian || options.offset) {
+        throw Error(options.endian ? "--endian" : "--offset",
+                    "applies only to raw input, and '" + path + "' is read as " + std::string(volume_format_name(format)));
     }
+    return format;
+}
 
-    Placement placement = volume.placement();
+// --spacing / --origin over what the file says, then the placement limits.
+Placement overridden_placement(Placement placement, Dims dims, const std::string& path, const RawOptions& options) {
     if (options.spacing) placement.spacing = *options.spacing;
     if (options.origin) placement.origin = *options.origin;
-    check_placement(placement, volume.dims(), path, "; override it with --spacing/--origin");
-    volume.set_placement(placement);
+    check_placement(placement, dims, path, "; override it with --spacing/--origin");
+    return placement;
+}
+
+}  // namespace
+
+LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
+    const VolumeFormat format = choose_format(path, options);
+    LoadedVolume volume = format == VolumeFormat::raw
+                              ? read_raw(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
+                                         options.offset.value_or(0))
+                              : read_vtk(path, format);
+    if (format == VolumeFormat::nifti) {
+        // CONVENTIONS 2b: an axis-aligned sform/qform places the grid, as the streaming reader
+        // does, so both paths write the same header. Not where VTK reverses the slices (qfac -1)
+        // or the affine flips or rotates an axis: VTK's placement stays for those.
+        const io::NiftiHeader h = io::read_nifti_header(path);
+        if (h.unplaced.empty() && h.qfac > 0) volume.set_placement(h.placement);
+    }
+    volume.set_placement(overridden_placement(volume.placement(), volume.dims(), path, options));
     return volume;
+}
+
+bool is_streamable(const std::string& path, const RawOptions& options) {
+    const VolumeFormat f = choose_format(path, options);
+    return f == VolumeFormat::raw || f == VolumeFormat::nifti;
+}
+
+std::unique_ptr<VolumeStream> open_volume_stream(const std::string& path, const RawOptions& options) {
+    const VolumeFormat format = choose_format(path, options);
+    std::unique_ptr<VolumeStream> s;
+    if (format == VolumeFormat::raw)
+        s = open_raw_stream(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
+                            options.offset.value_or(0));
+    else if (format == VolumeFormat::nifti)
+        s = open_nifti_stream(path);
+    else
+        throw Error(path, std::string(volume_format_name(format)) + " input is read whole, not streamed", ErrorKind::Other);
+    s->set_placement(overridden_placement(s->placement(), s->dims(), path, options));
+    return s;
 }
 
 }  // namespace octiso

@@ -30,6 +30,7 @@
 #include "octiso/build.h"
 #include "octiso/error.h"
 #include "octree/prepare.h"
+#include "octree/piece_builder.h"
 #include "octree/summary.h"
 #include "util/check.h"
 
@@ -50,94 +51,9 @@ template <typename T> Octree<T> OctreeData<T>::view() const {
 
 namespace {
 
+using detail::Builder;
+using detail::Sink;
 using detail::Summary;
-
-/// One piece's output: node records by absolute depth, caps, leaf counts by depth.
-template <typename T> struct Sink {
-    std::vector<std::vector<InteriorNode<T>>> nodes;
-    std::vector<Cap<T>> caps;
-    std::vector<uint64_t> leaves;
-    explicit Sink(int dmax) : nodes(size_t(dmax)), leaves(size_t(dmax), 0) {}
-};
-
-template <typename T> class Builder {
-public:
-    Builder(const VolumeView<T>& v, int dmax, double tolerance)
-        : v_(v), dims_(v.dims), dmax_(dmax), tolerance_(tolerance) {}
-
-    uint32_t child_bit(int d) const { return 1u << (dmax_ - d - 1); }
-
-    static Summary<T> padding() { return Summary<T>::padding(); }
-
-    bool outside(Coord o) const { return o.x >= dims_.x || o.y >= dims_.y || o.z >= dims_.z; }
-
-    static Coord child_origin(Coord o, int c, uint32_t half) { return detail::child_origin(o, c, half); }
-
-    /// Whether values in [lo, hi] may become one value `rep` with |v - rep| <= tolerance for all.
-    bool mergeable(T lo, T hi, T& rep) const {
-        if (lo == hi) { rep = lo; return true; }
-        if (tolerance_ <= 0) return false;
-        const double a = double(lo), b = double(hi);
-        if (b - a > 2 * tolerance_) return false;
-        double m = a + (b - a) / 2;
-        if constexpr (!std::is_floating_point_v<T>) m = std::round(m);
-        const T r = T(m);
-        if (double(r) - a > tolerance_ || b - double(r) > tolerance_) return false;
-        rep = r;
-        return true;
-    }
-
-    /// Widening of a cell range by the tolerance, so that it also bounds the stored (lossy) values.
-    void widen(T& lo, T& hi) const {
-        if (tolerance_ <= 0 || lo > hi) return;
-        const double l = std::floor(double(lo) - tolerance_), h = std::ceil(double(hi) + tolerance_);
-        lo = l <= double(std::numeric_limits<T>::lowest()) ? std::numeric_limits<T>::lowest() : T(l);
-        hi = h >= double(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::max() : T(h);
-    }
-
-    /// Subtree of the node at depth d (d <= dmax-2) with origin o, into `sink`.
-    Summary<T> build(int d, Coord o, Sink<T>& sink) const {
-        if (outside(o)) return padding();
-        if (d == dmax_ - 2) return build_cap_parent(o, sink);
-        Summary<T> ch[8];
-        const uint64_t start = sink.nodes[size_t(d + 1)].size();
-        const uint32_t half = child_bit(d);
-        for (int c = 0; c < 8; ++c) ch[c] = build(d + 1, child_origin(o, c, half), sink);
-        return combine(d, ch, start, sink);
-    }
-
-    /// Folds 8 child summaries into a leaf, or stores an interior node at depth d.
-    /// `start` is the index the first stored child got at depth d+1 (local to the sink).
-    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, Sink<T>& sink) const {
-        Summary<T> out;
-        InteriorNode<T> n;
-        auto merge = [this](T lo, T hi, T& rep) { return mergeable(lo, hi, rep); };
-        if (detail::fold_children(d, ch, start, merge, out, n)) return out;
-        sink.nodes[size_t(d)].push_back(n);
-        sink.leaves[size_t(d)] += uint64_t(8 - std::popcount(unsigned(n.child_mask)));
-        return out;
-    }
-
-    /// A node at depth dmax-2: 4^3 voxels in 8 blocks of 2^3, each a scalar leaf or a cap.
-    Summary<T> build_cap_parent(Coord o, Sink<T>& sink) const {
-        // 1. The 5^3 neighbourhood from o, clamped into the data (summary.h).
-        T L[5][5][5];
-        detail::load_neighbourhood(o, dims_, [this](uint32_t x, uint32_t y, uint32_t z) { return v_.at(x, y, z); }, L);
-
-        // 2. Each block: a scalar leaf or a cap (summary.h).
-        Summary<T> ch[8];
-        const uint64_t start = sink.caps.size();
-        detail::cap_parent_children(
-            L, o, dims_, [this](T lo, T hi, T& rep) { return mergeable(lo, hi, rep); },
-            [this](T& lo, T& hi) { widen(lo, hi); }, [&](const Cap<T>& cap) { sink.caps.push_back(cap); }, ch);
-        return combine(dmax_ - 2, ch, start, sink);
-    }
-
-    const VolumeView<T> v_;
-    const Dims dims_;
-    const int dmax_;
-    const double tolerance_;
-};
 
 /// Appends `src` to `dst` at `at`, then frees `src`, so each piece's memory goes as it is copied.
 template <typename U> void move_into(UninitArray<U>& dst, uint64_t& at, std::vector<U>& src) {
@@ -162,7 +78,7 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
     out.dims = input.dims;
     out.dmax = dmax_for(input.dims);
     const int dmax = out.dmax;
-    const Builder<T> builder(prepared.view, dmax, options.tolerance);
+    const Builder<T> builder(prepared.view, input.dims, dmax, options.tolerance);
 
     // 1. Pieces: the nodes at split depth k that the top-level descent reaches, in DFS order.
     const int k = std::min(dmax - 2, 3);

@@ -36,8 +36,8 @@ inline void and3_line(uint8_t* p, uint64_t n, uint64_t stride) {
     }
 }
 
-template <typename T> std::string voxel_text(const VolumeView<T>& v, uint64_t i) {
-    const uint64_t x = i % v.dims.x, y = (i / v.dims.x) % v.dims.y, z = i / (uint64_t(v.dims.x) * v.dims.y);
+template <typename T> std::string voxel_text(const VolumeView<T>& v, uint64_t i, uint32_t z_first) {
+    const uint64_t x = i % v.dims.x, y = (i / v.dims.x) % v.dims.y, z = i / (uint64_t(v.dims.x) * v.dims.y) + z_first;
     return "(" + std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) + ")";
 }
 
@@ -69,7 +69,8 @@ template <typename T> T clamp_target_high(double hi) {
     }
 }
 
-template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& input, const BuildOptions& options) {
+template <typename T>
+PreparedVolume<T> prepare_volume(const VolumeView<T>& input, const BuildOptions& options, uint32_t z_first) {
     PreparedVolume<T> out;
     out.view = input;
     const uint64_t n = input.dims.voxels();
@@ -86,7 +87,7 @@ template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& inpu
             [](uint64_t a, uint64_t b) { return a < b ? a : b; });
         if (first_bad < n) {
             if (!options.nan_as)
-                throw Error(options.source_name, "voxel " + voxel_text(input, first_bad) + " is " +
+                throw Error(options.source_name, "voxel " + voxel_text(input, first_bad, z_first) + " is " +
                                                      (std::isnan(input.load(first_bad)) ? "NaN" : "infinite") +
                                                      " (pass --nan-as V to replace non-finite values)");
             out.storage.resize(n);
@@ -139,7 +140,7 @@ template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& inpu
 }
 
 #define OCTISO_INSTANTIATE(T)                                                                  \
-    template PreparedVolume<T> prepare_volume<T>(const VolumeView<T>&, const BuildOptions&); \
+    template PreparedVolume<T> prepare_volume<T>(const VolumeView<T>&, const BuildOptions&, uint32_t); \
     template T clamp_target_low<T>(double);                                                   \
     template T clamp_target_high<T>(double);
 OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)

@@ -14,7 +14,12 @@ template <typename T> struct PreparedVolume {
     std::vector<T> storage;  ///< the modified copy, empty when the input is used as is
 };
 
-template <typename T> PreparedVolume<T> prepare_volume(const VolumeView<T>& input, const BuildOptions& options);
+/// `input` may be a slab of layers [z_first, z_first + input.dims.z) of a larger grid (the
+/// streaming converter): messages then name global voxels, and iso-range clamping is exact on
+/// every layer whose 3x3x3 neighbourhood the slab holds (all but its first and last, unless those
+/// are the grid's own ends).
+template <typename T>
+PreparedVolume<T> prepare_volume(const VolumeView<T>& input, const BuildOptions& options, uint32_t z_first = 0);
 
 /// The stored value that stands for "at or below LO" (resp. "at or above HI"): the largest T <= lo
 /// (smallest T >= hi), so a clamped voxel stays on the same side of every iso in (LO, HI).

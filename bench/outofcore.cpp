@@ -1,0 +1,181 @@
+// octiso-bench outofcore: the out-of-core converter against the in-memory one (issue 13). A large
+// u8 raw file is written once (a smooth deterministic field, layer by layer, never whole in
+// memory), converted in a child process with --memory BYTES and again with --in-memory; per path
+// the wall time, Mvoxel/s, the child's peak RSS, bytes read and written and spilled; then the two
+// files compared byte for byte, and the sha256 of the voxels octiso-info --extract-raw gives back
+// compared with the input's. --quick: a small grid and a tight budget, so that CI runs the whole
+// path (seams, spilling, extraction) in seconds.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <vector>
+
+#include "bench/bench.h"
+#include "bench/tools.h"
+#include "octiso/error.h"
+#include "octiso/volume.h"
+
+namespace octiso::bench {
+namespace {
+
+const char* const kOutOfCoreUsage =
+    "usage: octiso-bench outofcore [--dims NX,NY,NZ] [--memory BYTES] [--dir DIR] [--threads N] [--keep] [--quick]\n"
+    "  u8 NX*NY*NZ (default 1024,1024,1024) written once to DIR (default $TMPDIR) as outofcore_NXxNYxNZ.raw and\n"
+    "  reused; converted with --memory (default 1G) and --in-memory; --keep keeps the input for the next run";
+
+/// The value of voxel (x, y, z): nested shells and slow waves, so the octree has structure at
+/// every depth (about as compressible as the paper's scans).
+uint8_t field(uint32_t x, uint32_t y, uint32_t z) {
+    const double a = std::sin(x * 0.031) * std::cos(y * 0.023) + std::sin(z * 0.017 + x * 0.004);
+    const double r = std::sqrt(double(x % 256) * (x % 256) + double(y % 192) * (y % 192) + double(z % 320) * (z % 320));
+    const double v = 96 + 60 * a + 40 * std::sin(r * 0.05);
+    return uint8_t(std::lround(std::clamp(v, 0.0, 255.0)) & ~3);   // quantised: uniform runs merge
+}
+
+void write_input(const std::string& path, Dims d) {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) throw Error(path, "cannot create", ErrorKind::Other);
+    std::vector<uint8_t> layer(uint64_t(d.x) * d.y);
+    for (uint32_t z = 0; z < d.z; ++z) {
+        for (uint32_t y = 0; y < d.y; ++y)
+            for (uint32_t x = 0; x < d.x; ++x) layer[uint64_t(y) * d.x + x] = field(x, y, z);
+        if (std::fwrite(layer.data(), 1, layer.size(), f) != layer.size()) {
+            std::fclose(f);
+            throw Error(path, "write failed", ErrorKind::Other);
+        }
+    }
+    if (std::fclose(f) != 0) throw Error(path, "write failed", ErrorKind::Other);
+}
+
+std::string sha256_of(const std::string& path) {
+    const std::string out = [&] {
+        std::FILE* p = ::popen(("sha256sum " + shell_quote(path)).c_str(), "r");
+        if (!p) throw Error("sha256sum", "cannot start", ErrorKind::Other);
+        char buf[128] = {};
+        const size_t n = std::fread(buf, 1, 64, p);
+        ::pclose(p);
+        return std::string(buf, n);
+    }();
+    if (out.size() != 64) throw Error("sha256sum", "no digest for " + path, ErrorKind::Other);
+    return out;
+}
+
+bool same_files(const std::string& a, const std::string& b) {
+    std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+    std::vector<char> ba(1 << 20), bb(1 << 20);
+    while (fa && fb) {
+        fa.read(ba.data(), std::streamsize(ba.size()));
+        fb.read(bb.data(), std::streamsize(bb.size()));
+        if (fa.gcount() != fb.gcount() || std::memcmp(ba.data(), bb.data(), size_t(fa.gcount())) != 0) return false;
+    }
+    return fa.eof() && fb.eof();
+}
+
+struct PathRow {
+    std::string name;
+    double wall_seconds = 0, build_seconds = 0, mvoxels_per_second = 0;
+    uint64_t peak_rss = 0, bytes_read = 0, file_bytes = 0, spilled = 0, piece_side = 0;
+    bool streamed = false, lossless = false;
+};
+
+double mib(uint64_t b) { return double(b) / 1048576.0; }
+
+int run_outofcore(cli::Args& args) {
+    if (args.flag("--help")) {
+        std::cout << kOutOfCoreUsage << "\n";
+        return 0;
+    }
+    const bool quick = args.flag("--quick"), keep = args.flag("--keep");
+    const auto dims_flag = args.value("--dims"), memory_flag = args.value("--memory");
+    const auto dir_flag = args.value("--dir"), threads_flag = args.value("--threads");
+    const std::string results = results_dir(args);
+    args.finish();
+    const Dims d = dims_flag ? parse_dims(*dims_flag, "--dims") : quick ? Dims{160, 144, 130} : Dims{1024, 1024, 1024};
+    const std::string memory = memory_flag ? *memory_flag : quick ? "4M" : "1G";
+    const std::string dir = dir_flag ? *dir_flag : std::filesystem::temp_directory_path().string();
+    const std::string tag = std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+    const std::string input = dir + "/outofcore_" + tag + ".raw";
+    const uint64_t voxels = d.voxels();
+
+    // 1. The input, once: reused while its size is right (written by an earlier run with --keep).
+    std::error_code ec;
+    const auto t_write = std::chrono::steady_clock::now();
+    bool written = false;
+    if (std::filesystem::file_size(input, ec) != voxels || ec) {
+        write_input(input, d);
+        written = true;
+    }
+    const double write_seconds = seconds_since(t_write);
+    const std::string input_sha = sha256_of(input);
+
+    // 2. Both paths, in child processes (each peak RSS is its own), then the data back.
+    std::vector<PathRow> rows;
+    const std::string dims_arg = std::to_string(d.x) + "," + std::to_string(d.y) + "," + std::to_string(d.z);
+    for (const bool streamed : {true, false}) {
+        PathRow r;
+        r.name = streamed ? "--memory " + memory : "--in-memory";
+        const std::string out = dir + "/outofcore_" + tag + (streamed ? "_streamed.oct" : "_in_memory.oct");
+        std::vector<std::string> a{input, "--dims", dims_arg, "--type", "u8", "-o", out, "--json"};
+        if (streamed) a.insert(a.end(), {"--memory", memory});
+        else a.push_back("--in-memory");
+        if (threads_flag) a.insert(a.end(), {"--threads", *threads_flag});
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::string json = run_tool("octiso-convert", a);
+        r.wall_seconds = seconds_since(t0);
+        r.build_seconds = json_number(json, "build_seconds");
+        r.mvoxels_per_second = double(voxels) / r.wall_seconds / 1e6;
+        r.peak_rss = uint64_t(json_number(json, "peak_rss_bytes"));
+        r.file_bytes = uint64_t(json_number(json, "file_bytes"));
+        r.streamed = json.find("\"streamed\":true") != std::string::npos;
+        r.bytes_read = streamed ? uint64_t(json_number(json, "bytes_read")) : voxels;   // in memory: mapped
+        r.spilled = uint64_t(json_number(json, "spilled_bytes"));
+        r.piece_side = uint64_t(json_number(json, "piece_side"));
+        const std::string extracted = dir + "/outofcore_" + tag + "_extracted.raw";
+        run_tool("octiso-info", {out, "--extract-raw", extracted});
+        r.lossless = sha256_of(extracted) == input_sha;
+        std::filesystem::remove(extracted, ec);
+        rows.push_back(r);
+    }
+    const std::string a = dir + "/outofcore_" + tag + "_streamed.oct", b = dir + "/outofcore_" + tag + "_in_memory.oct";
+    const bool identical = same_files(a, b);
+    std::filesystem::remove(a, ec);
+    std::filesystem::remove(b, ec);
+    if (!keep) std::filesystem::remove(input, ec);
+
+    std::cout << "out-of-core conversion, u8 " << tag << " (" << fmt(mib(voxels), 1) << " MiB), input "
+              << (written ? "written in " + fmt(write_seconds, 1) + " s" : "reused") << " (" << machine_description() << ")\n";
+    Table table({"path", "wall s", "build s", "Mvoxel/s", "peak RSS MiB", "read MiB", "written MiB", "spilled MiB",
+                 "piece", "extracted sha256 = input"});
+    for (const PathRow& r : rows)
+        table.add({r.name, fmt(r.wall_seconds, 2), fmt(r.build_seconds, 2), fmt(r.mvoxels_per_second, 1),
+                   fmt(mib(r.peak_rss), 1), r.streamed ? fmt(mib(r.bytes_read), 1) : fmt(mib(r.bytes_read), 1) + " (mapped)",
+                   fmt(mib(r.file_bytes), 1), fmt(mib(r.spilled), 1), r.streamed ? std::to_string(r.piece_side) + "^3" : "-",
+                   r.lossless ? "yes" : "NO"});
+    table.print(std::cout);
+    std::cout << "the two .oct files are " << (identical ? "identical, byte for byte" : "DIFFERENT") << "; throughput "
+              << fmt(100.0 * rows[0].mvoxels_per_second / rows[1].mvoxels_per_second, 1) << " % of in-memory\n";
+    const std::string path = write_json(results, quick ? "outofcore" : "outofcore_" + tag, [&](cli::JsonWriter& j) {
+        j.field("dims", tag).field("type", std::string("u8")).field("input_bytes", voxels).field("memory", memory);
+        j.field("machine", machine_description()).field("identical", identical).field("input_sha256", input_sha);
+        j.key("paths").begin_array();
+        for (const PathRow& r : rows) {
+            j.begin_object().field("path", r.name).field("streamed", r.streamed).field("wall_seconds", r.wall_seconds);
+            j.field("build_seconds", r.build_seconds).field("mvoxels_per_second", r.mvoxels_per_second);
+            j.field("peak_rss_bytes", r.peak_rss).field("bytes_read", r.bytes_read).field("file_bytes", r.file_bytes);
+            j.field("spilled_bytes", r.spilled).field("piece_side", r.piece_side).field("lossless", r.lossless).end_object();
+        }
+        j.end_array();
+    });
+    std::cout << "wrote " << path << "\n";
+    return identical && rows[0].lossless && rows[1].lossless ? 0 : 1;
+}
+
+const bool kRegistered =
+    register_bench("outofcore", "out-of-core conversion under --memory vs in memory: time, RSS, lossless", &run_outofcore);
+
+}  // namespace
+}  // namespace octiso::bench
