@@ -14,18 +14,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "octiso/inline.h"
 #include "octiso/volume.h"
-
-// Point location is forced inline: the traversal is compiled once per instruction set
-// (src/util/isa.h), and an out-of-line copy shared between those builds could run AVX2 code on a
-// CPU without it.
-#ifndef OCTISO_ALWAYS_INLINE
-#if defined(__GNUC__)
-#define OCTISO_ALWAYS_INLINE [[gnu::always_inline]] inline
-#else
-#define OCTISO_ALWAYS_INLINE inline
-#endif
-#endif
 
 namespace octiso {
 

@@ -67,6 +67,26 @@ ConvertReport convert_sparse_spheres(const ConvertSource& source, const std::str
     return r;
 }
 
+/// What both build paths report alike once the file is written: sizes, names, grid, options.
+/// The file's size on disk is what a user sees; bytes_written() is the fallback.
+void fill_report(ConvertReport& r, const ConvertSource& source, const std::string& output,
+                 const convert_detail::GridOfStep& first, int dmax, uint32_t n_steps, const BuildOptions& options,
+                 const OctWriter& writer) {
+    struct stat st {};
+    r.file_bytes = ::stat(output.c_str(), &st) == 0 ? uint64_t(st.st_size) : writer.bytes_written();
+    r.peak_rss_bytes = peak_rss_bytes();
+    r.input = source.name();
+    r.output = output;
+    r.format = first.format;
+    r.type = first.type;
+    r.dims = first.dims;
+    r.placement = first.placement;
+    r.dmax = dmax;
+    r.steps = n_steps;
+    r.iso_range = options.iso_range;
+    r.tolerance = options.tolerance;
+}
+
 convert_detail::GridOfStep grid_of(const VolumeStream& s) {
     return {s.source(), s.format(), s.type(), s.dims(), s.placement(), s.bytes()};
 }
@@ -127,19 +147,7 @@ ConvertReport convert_streamed(const ConvertSource& source, const std::string& o
     }
     writer.finish();
 
-    struct stat st {};
-    r.file_bytes = ::stat(output.c_str(), &st) == 0 ? uint64_t(st.st_size) : writer.bytes_written();
-    r.peak_rss_bytes = peak_rss_bytes();
-    r.input = source.name();
-    r.output = output;
-    r.format = first.format;
-    r.type = first.type;
-    r.dims = first.dims;
-    r.placement = first.placement;
-    r.dmax = info.dmax;
-    r.steps = n_steps;
-    r.iso_range = options.iso_range;
-    r.tolerance = options.tolerance;
+    fill_report(r, source, output, first, info.dmax, n_steps, options, writer);
     r.input_bytes = all_bytes;
     r.threads = active_threads();
     r.streamed = true;
@@ -251,20 +259,8 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     }
     writer.finish();
 
-    // 3. Measure. The file's size on disk is what a user sees; bytes_written() is the fallback.
-    struct stat st {};
-    r.file_bytes = ::stat(output.c_str(), &st) == 0 ? uint64_t(st.st_size) : writer.bytes_written();
-    r.peak_rss_bytes = peak_rss_bytes();
-    r.input = source.name();
-    r.output = output;
-    r.format = first.format;
-    r.type = first.type;
-    r.dims = first.dims;
-    r.placement = first.placement;
-    r.dmax = info.dmax;
-    r.steps = n_steps;
-    r.iso_range = options.iso_range;
-    r.tolerance = options.tolerance;
+    // 3. Measure.
+    fill_report(r, source, output, first, info.dmax, n_steps, options, writer);
     r.input_bytes = first.bytes * n_steps;
     r.threads = active_threads();
     r.memory_budget = budget;

@@ -17,10 +17,4 @@
 #define OCTISO_ISA_BEGIN inline namespace OCTISO_ISA_NAMESPACE {
 #define OCTISO_ISA_END }
 
-#ifndef OCTISO_ALWAYS_INLINE
-#if defined(__GNUC__)
-#define OCTISO_ALWAYS_INLINE [[gnu::always_inline]] inline
-#else
-#define OCTISO_ALWAYS_INLINE inline
-#endif
-#endif
+#include "octiso/inline.h"   // OCTISO_ALWAYS_INLINE
