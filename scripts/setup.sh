@@ -9,7 +9,7 @@ packages=(
   libgtest-dev libbenchmark-dev libxxhash-dev zstd libzstd-dev
   libopenvdb-dev libboost-iostreams-dev mricron-data
   python3-numpy python3-matplotlib python3-dev pybind11-dev python3-pytest python3-nibabel clang
-  libcpp-httplib-dev
+  libcpp-httplib-dev chromium chromium-driver python3-selenium
 )
 
 missing=()
