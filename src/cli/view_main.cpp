@@ -4,6 +4,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <pthread.h>
 #include <thread>
 
@@ -16,8 +17,9 @@ namespace octiso {
 namespace {
 
 const char* kUsage =
-    "usage: octiso-view FILE.oct [--port P] [--host H] [--threads N]\n"
-    "  serves an interactive viewer of FILE.oct at http://H:P/ (default 127.0.0.1:8080; --port 0 picks a free port)";
+    "usage: octiso-view FILE.oct [--port P] [--host H] [--threads N] [--iso V]\n"
+    "  serves an interactive viewer of FILE.oct at http://H:P/ (default 127.0.0.1:8080; --port 0 picks a free port);\n"
+    "  --iso: the isovalue the page starts at (default: the middle of the data's range)";
 
 int run(std::vector<std::string>& argv) {
     cli::Args args(argv);
@@ -26,6 +28,7 @@ int run(std::vector<std::string>& argv) {
         return 0;
     }
     const auto port = args.value("--port"), host = args.value("--host"), threads = args.value("--threads");
+    const auto iso = args.value("--iso");
     const std::vector<std::string> inputs = args.positional();
     args.finish();
     if (inputs.size() != 1) throw Error("octiso-view", std::string("expected exactly one FILE.oct\n") + kUsage);
@@ -36,6 +39,8 @@ int run(std::vector<std::string>& argv) {
         options.host = *host;
     }
     const int n_threads = threads ? int(cli::parse_int(*threads, "--threads", 1, 4096)) : 0;
+    std::optional<double> initial_iso;
+    if (iso) initial_iso = cli::parse_double(*iso, "--iso");
 
     // Signals are taken by one thread with sigwait, so no handler runs inside httplib's workers;
     // blocked before any thread exists, so every thread inherits the mask. A shell starts a
@@ -49,7 +54,7 @@ int run(std::vector<std::string>& argv) {
     sigaddset(&stop_signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
-    view::ViewSession session(inputs[0], n_threads);
+    view::ViewSession session(inputs[0], n_threads, initial_iso);
     view::ViewServer server(session, options);
     if (!view::is_loopback_host(options.host))
         std::fprintf(stderr, "octiso-view: warning: listening on %s: every machine that reaches this address can use the "

@@ -53,7 +53,8 @@ std::string json_string(const std::string& s) {
 
 std::string json_number(double v) { return std::isfinite(v) ? exact(v) : "null"; }
 
-std::string build_info_json(const std::string& path, const OctInfo& info, const AnyOctreeInfo& step0, const Histogram& h) {
+std::string build_info_json(const std::string& path, const OctInfo& info, const AnyOctreeInfo& step0, const Histogram& h,
+                            std::optional<double> initial_iso) {
     std::string j = "{\"file\":" + json_string(path) + ",\"type\":" + json_string(std::string(scalar_type_name(info.type)));
     j += ",\"dims\":[" + std::to_string(info.dims.x) + "," + std::to_string(info.dims.y) + "," + std::to_string(info.dims.z) + "]";
     j += ",\"spacing\":[" + vec3(info.placement.spacing) + "],\"origin\":[" + vec3(info.placement.origin) + "]";
@@ -62,6 +63,7 @@ std::string build_info_json(const std::string& path, const OctInfo& info, const 
         return r ? "[" + json_number((*r)[0]) + "," + json_number((*r)[1]) + "]" : std::string("null");
     };
     j += ",\"value_range\":" + range(step0.value_range) + ",\"iso_range\":" + range(info.iso_range);
+    j += ",\"initial_iso\":" + (initial_iso ? json_number(*initial_iso) : std::string("null"));
     j += ",\"histogram\":{\"lo\":" + json_number(h.lo) + ",\"hi\":" + json_number(h.hi) + ",\"counts\":[";
     for (size_t i = 0; i < h.counts.size(); ++i) j += (i ? "," : "") + std::to_string(h.counts[i]);
     j += "]},\"default_azimuth\":" + exact(kDefaultAzimuthDeg) + ",\"default_elevation\":" + exact(kDefaultElevationDeg);
@@ -108,13 +110,18 @@ std::string render_command(const std::string& path, const Camera& camera, double
     return c;
 }
 
-ViewSession::ViewSession(const std::string& path, int threads)
+ViewSession::ViewSession(const std::string& path, int threads, std::optional<double> initial_iso)
     : path_(path), threads_(threads), file_(std::make_shared<const OctFile>(OctFile::open(path))) {
     if (file_->info().step_count == 0) throw Error(path, "the file has no steps");
     renderers_.resize(file_->info().step_count);
     const AnyOctree step0 = AnyOctree::step(file_, 0);   // validated now: a bad file fails before serving
     histogram_ = value_histogram(step0, 128, uint64_t(1) << 30);
-    info_json_ = build_info_json(path_, file_->info(), step0.info(), histogram_);
+    if (initial_iso) {   // refused now, not as a first frame the page cannot show
+        RenderOptions options;
+        options.isovalues = {*initial_iso};
+        validate_options(options, step0.render_limits());
+    }
+    info_json_ = build_info_json(path_, file_->info(), step0.info(), histogram_, initial_iso);
 }
 
 Camera ViewSession::camera_for(const FrameRequest& r) const {

@@ -7,6 +7,7 @@
 #include <array>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,8 @@ class ViewSession {
 public:
     /// Opens `path` (OctFile::open: header and tables checked; step 0 validated here, so a bad
     /// file fails before the server starts). Throws Error(path, ...). threads: 0 = all cores.
-    ViewSession(const std::string& path, int threads);
+    /// initial_iso: the isovalue the page starts at (/info "initial_iso"); none: the middle of the range.
+    ViewSession(const std::string& path, int threads, std::optional<double> initial_iso = {});
 
     /// Renders `request` (its step's Renderer made on first use). Not thread-safe: callers
     /// serialise (the Coalescer does). Throws Error for an isovalue the file cannot render.

@@ -12,6 +12,7 @@
 #include <httplib.h>
 
 #include "octiso/any_octree.h"
+#include "octiso/error.h"
 #include "octiso/synthetic.h"
 #include "test_util/scratch_dir.h"
 #include "view/png.h"
@@ -82,6 +83,7 @@ TEST_F(ViewServerTest, ServesThePageAndInfo) {
     EXPECT_EQ(info->body, session_->info_json());
     EXPECT_NE(info->body.find("\"dims\":[24,24,24]"), std::string::npos) << info->body;
     EXPECT_NE(info->body.find("\"steps\":1"), std::string::npos) << info->body;
+    EXPECT_NE(info->body.find("\"initial_iso\":null"), std::string::npos) << info->body;
     uint64_t total = 0;
     for (const uint64_t c : session_->histogram().counts) total += c;
     EXPECT_EQ(session_->histogram().counts.size(), 128u);
@@ -167,6 +169,19 @@ TEST_F(ViewServerTest, IsovalueOutsideTheFilesIsoRangeIsRefused) {
     auto ok = get("/frame?iso=5&az=0&el=0&w=8&h=8");
     ASSERT_TRUE(ok);
     EXPECT_EQ(ok->status, 200);
+}
+
+TEST_F(ViewServerTest, InitialIsovalueIsOfferedAndCheckedAgainstTheIsoRange) {
+    BuildOptions clamped;
+    clamped.iso_range = std::array<double, 2>{2.0, 10.0};
+    AnyOctree::build(make_synthetic(parse_synthetic("sphere:24")), clamped).save(path_);
+    EXPECT_NE(ViewSession(path_, 1, 5.25).info_json().find("\"initial_iso\":5.25,"), std::string::npos);
+    try {
+        ViewSession(path_, 1, 11.0);
+        ADD_FAILURE() << "an initial isovalue outside the file's iso-range must be refused";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("iso-range"), std::string::npos) << e.what();
+    }
 }
 
 TEST_F(ViewServerTest, RequestsBeyondTheRateBoundAreRefused) {

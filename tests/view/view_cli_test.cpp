@@ -48,6 +48,7 @@ TEST_F(ViewCli, BadFileOrFlagsExitTwoWithOneLine) {
         {"'" + junk + "' --port 70000", "--port"},
         {"'" + junk + "' --threads 0", "--threads"},
         {"'" + junk + "' --bogus", "--bogus"},
+        {"'" + junk + "' --iso abc", "--iso"},
     };
     for (const auto& [args, needle] : cases) {
         std::string out, err;
