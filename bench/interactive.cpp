@@ -40,7 +40,8 @@ const char* const kInteractiveUsage =
     "  default datasets ch2better and marschner-lobb:256 (--quick: marschner-lobb:64 for the synthetic);\n"
     "  --changes isovalue changes per size (default 60, --quick 4), --threads render threads (default 2);\n"
     "  mesh: median of 3 isovalues (--quick: 1).\n"
-    "  Latency: GET /frame sent -> PNG received and decoded, p50 and p95; mesh: extraction + BVH per change.";
+    "  Latency: GET /frame sent -> PNG received and decoded, p50 and p95; mesh: extraction + BVH per change;\n"
+    "  orbit: --changes azimuth steps at a third of the side (the page's drag frames), frames/s back to back.";
 
 #ifdef OCTISO_HAVE_VIEW
 
@@ -50,6 +51,8 @@ struct Row {
     double p50_ms = 0, p95_ms = 0, render_p50_ms = 0, max_ms = 0;
     double mesh_extract_ms = 0, mesh_bvh_ms = 0;
     uint64_t hits_last = 0;
+    int preview_side = 0;                  ///< the page's drag frames: a third of the side
+    double orbit_fps = 0, orbit_p95_ms = 0;   ///< back-to-back azimuth changes at preview_side
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -101,7 +104,8 @@ int run_interactive(cli::Args& args) {
     const int threads = threads_flag ? int(cli::parse_int(*threads_flag, "--threads", 1, 1024)) : 2;
 
     std::vector<Row> rows;
-    Table table({"dataset", "image", "changes", "p50 ms", "p95 ms", "max ms", "render p50 ms", "mesh extract ms", "mesh BVH ms"});
+    Table table({"dataset", "image", "changes", "p50 ms", "p95 ms", "max ms", "render p50 ms", "mesh extract ms", "mesh BVH ms",
+                 "orbit frames", "orbit fps", "orbit p95 ms"});
     const auto scratch = std::filesystem::temp_directory_path() / ("octiso-bench-interactive-" + std::to_string(::getpid()));
     std::filesystem::create_directories(scratch);
     for (const std::string& spec : datasets) {
@@ -137,6 +141,7 @@ int run_interactive(cli::Args& args) {
             Serving serving{server};
             httplib::Client client("127.0.0.1", server.bound_port());
             client.set_keep_alive(true);
+            client.set_tcp_nodelay(true);   // as a browser does
             client.set_read_timeout(120, 0);
             for (int side : sides) {
                 Row row{name, side, changes};
@@ -159,6 +164,23 @@ int run_interactive(cli::Args& args) {
                     const size_t h = stats.find("hits=");
                     row.hits_last = std::stoull(stats.substr(h + 5));
                 }
+                // Orbiting: the page's drag frames (a third of the side), one azimuth step of 2
+                // degrees per request, each sent when the previous one is decoded.
+                row.preview_side = std::max(1, (side + 1) / 3);
+                std::vector<double> orbit;
+                const auto orbit_start = std::chrono::steady_clock::now();
+                for (int i = 0; i < changes; ++i) {
+                    char target[256];
+                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d", iso_of(0),
+                                  kDefaultAzimuthDeg + 2.0 * (i + 1), kDefaultElevationDeg, row.preview_side, row.preview_side, i);
+                    const auto t0 = std::chrono::steady_clock::now();
+                    auto res = client.Get(target);
+                    if (!res || res->status != 200) throw Error(name, "viewer refused an orbit frame", ErrorKind::Other);
+                    decode_png(res->body);
+                    orbit.push_back(seconds_since(t0) * 1e3);
+                }
+                row.orbit_fps = double(changes) / seconds_since(orbit_start);
+                row.orbit_p95_ms = percentile(orbit, 0.95);
                 row.p50_ms = percentile(latency, 0.5);
                 row.p95_ms = percentile(latency, 0.95);
                 row.max_ms = percentile(latency, 1.0);
@@ -185,7 +207,8 @@ int run_interactive(cli::Args& args) {
     std::filesystem::remove_all(scratch);
     for (const Row& r : rows)
         table.add({r.dataset, std::to_string(r.side) + "^2", std::to_string(r.changes), fmt(r.p50_ms, 1), fmt(r.p95_ms, 1),
-                   fmt(r.max_ms, 1), fmt(r.render_p50_ms, 1), no_mesh ? "-" : fmt(r.mesh_extract_ms, 1), no_mesh ? "-" : fmt(r.mesh_bvh_ms, 1)});
+                   fmt(r.max_ms, 1), fmt(r.render_p50_ms, 1), no_mesh ? "-" : fmt(r.mesh_extract_ms, 1), no_mesh ? "-" : fmt(r.mesh_bvh_ms, 1),
+                   std::to_string(r.preview_side) + "^2", fmt(r.orbit_fps, 1), fmt(r.orbit_p95_ms, 1)});
     // The machine is shared: the 1-minute load average at the end says how much others ran meanwhile.
     double load = -1;
     if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
@@ -202,7 +225,8 @@ int run_interactive(cli::Args& args) {
         for (const Row& r : rows) {
             j.begin_object().field("dataset", r.dataset).field("image", int64_t(r.side)).field("p50_ms", r.p50_ms);
             j.field("p95_ms", r.p95_ms).field("max_ms", r.max_ms).field("render_p50_ms", r.render_p50_ms);
-            j.field("hits_last_frame", r.hits_last);
+            j.field("hits_last_frame", r.hits_last).field("orbit_preview_side", int64_t(r.preview_side));
+            j.field("orbit_fps", r.orbit_fps).field("orbit_p95_ms", r.orbit_p95_ms);
             if (!no_mesh) j.field("mesh_extract_ms", r.mesh_extract_ms).field("mesh_bvh_ms", r.mesh_bvh_ms);
             j.end_object();
         }
