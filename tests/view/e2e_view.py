@@ -113,9 +113,9 @@ def main():
                      "--window-size=800,600", "--force-device-scale-factor=1", "--force-color-profile=srgb"):
             options.add_argument(flag)
         driver = webdriver.Chrome(service=Service(executable_path=driver_path), options=options)
-        driver.set_script_timeout(20)
+        driver.set_script_timeout(90)
         driver.get(url)
-        wait = WebDriverWait(driver, 20)
+        wait = WebDriverWait(driver, 90)   # a bound, not a measurement: the ASan build renders slowly
         settled = lambda d: d.execute_script("return window.octiso.settled && window.octiso.lastFrame !== null")
         wait.until(settled)
         first = driver.execute_script("return window.octiso.lastFrame.command")
