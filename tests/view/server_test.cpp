@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <charconv>
+#include <cmath>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -13,8 +15,12 @@
 
 #include "octiso/any_octree.h"
 #include "octiso/error.h"
+#include "octiso/image.h"
+#include "octiso/oct_file.h"
 #include "octiso/synthetic.h"
+#include "test_util/run_shell.h"
 #include "test_util/scratch_dir.h"
+#include "test_util/skip.h"
 #include "view/png.h"
 #include "view/server.h"
 #include "view/session.h"
@@ -106,7 +112,8 @@ TEST_F(ViewServerTest, FrameIsTheRenderersImageAndItsCommandReproducesTheCamera)
     EXPECT_GT(expected.stats.hits, 0u);
     EXPECT_EQ(res->body, encode_png(expected)) << "same pixels through the same encoder, same bytes";
 
-    const std::string command = httplib::detail::decode_url(res->get_header_value("X-Octiso-Command"), false);
+    // httplib's client percent-decodes header values itself (the page uses decodeURIComponent).
+    const std::string command = res->get_header_value("X-Octiso-Command");
     EXPECT_EQ(command.rfind("octiso-render " + path_ + " --iso 5.5 ", 0), 0u) << command;
     EXPECT_EQ(vec3_after(command, "--eye"), camera.eye) << command;
     EXPECT_EQ(vec3_after(command, "--look"), camera.look) << command;
@@ -182,6 +189,59 @@ TEST_F(ViewServerTest, InitialIsovalueIsOfferedAndCheckedAgainstTheIsoRange) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("iso-range"), std::string::npos) << e.what();
     }
+}
+
+// A series: the step slider's requests render that step, and the offered command (--steps k:k with
+// a frame_%04d.png pattern) makes octiso-render write the same pixels.
+TEST_F(ViewServerTest, SeriesStepFrameAndItsCommandReproduceThatStep) {
+    const std::string tools = OCTISO_TOOLS_DIR;
+    if (!std::filesystem::exists(tools + "/octiso-render")) {
+        OCTISO_SKIP("octiso-render not built");
+    }
+    const Dims dims{20, 18, 16};
+    {
+        const AnyOctree step0 = AnyOctree::build(synthetic_step("plume-series", dims, 0), BuildOptions{});
+        OctWriter writer(path_, step0.oct_info());
+        step0.append_to(writer);
+        AnyOctree::build(synthetic_step("plume-series", dims, 1), BuildOptions{}).append_to(writer);
+        writer.finish();
+    }
+    session_ = std::make_unique<ViewSession>(path_, 2);
+    ServerOptions options;
+    options.port = 0;
+    server_ = std::make_unique<ViewServer>(*session_, options);
+    thread_ = std::thread([this] { server_->serve(); });
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", server_->bound_port());
+    EXPECT_NE(get("/info")->body.find("\"steps\":2"), std::string::npos);
+
+    auto res = get("/frame?iso=40.5&az=10&el=30&w=40&h=30&step=1");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << res->body;
+    RenderOptions render_options;
+    render_options.isovalues = {40.5};
+    const AnyOctree step1 = AnyOctree::open(path_, 1);
+    const Frame expected = step1.render(orbit_camera(dims, step1.placement(), 40, 30, 10, 30), render_options);
+    EXPECT_GT(expected.stats.hits, 0u);
+    EXPECT_EQ(res->body, encode_png(expected));
+    const Frame step0_frame = AnyOctree::open(path_, 0).render(orbit_camera(dims, step1.placement(), 40, 30, 10, 30), render_options);
+    EXPECT_NE(step0_frame.rgb, expected.rgb) << "the two steps must differ for this test to mean anything";
+
+    std::string command = res->get_header_value("X-Octiso-Command");   // decoded by httplib
+    const std::string tail = " --steps 1:1 -o frame_%04d.png";
+    ASSERT_EQ(command.substr(command.size() - tail.size()), tail) << command;
+    // Run it as offered: the file and the output pattern quoted for the shell, the flags as they are.
+    const std::string prefix = "octiso-render " + path_ + " ";
+    ASSERT_EQ(command.rfind(prefix, 0), 0u) << command;
+    const std::string flags = command.substr(prefix.size(), command.size() - prefix.size() - std::string("frame_%04d.png").size());
+    command = "'" + tools + "/octiso-render' '" + path_ + "' " + flags + "'" + dir_.file("frame_%04d.png") + "' 2>/dev/null";
+    ASSERT_EQ(test::run_shell(command), 0) << command;
+    const FloatImage written = read_image(dir_.file("frame_0001.png"));
+    ASSERT_EQ(written.width, 40);
+    ASSERT_EQ(written.height, 30);
+    ASSERT_EQ(written.channels, 3);
+    size_t differing = 0;
+    for (size_t i = 0; i < expected.rgb.size(); ++i) differing += std::lround(written.pixels[i] * 255.0f) != expected.rgb[i];
+    EXPECT_EQ(differing, 0u);
 }
 
 TEST_F(ViewServerTest, RequestsBeyondTheRateBoundAreRefused) {
