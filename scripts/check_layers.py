@@ -25,6 +25,7 @@ LAYERS = [
     ("io", ["include/octiso/reader.h", "include/octiso/image.h", "include/octiso/volume_writer.h", "src/io/"]),
     ("convert", ["include/octiso/convert.h", "src/convert/"]),
     ("reference", ["src/reference/"]),
+    ("view", ["src/view/"]),
     ("tools", ["src/cli/"]),
 ]
 

@@ -9,7 +9,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${OCTISO_FUZZ_BUILD_DIR:-$root/build-fuzz}
 seconds=${1:-45}
-targets="oct_loader raw_reader nifti_header render"
+targets="oct_loader raw_reader nifti_header render view_request"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=${CXX_FUZZ:-clang++} \
   -DOCTISO_FUZZ=ON -DOCTISO_BUILD_BENCH=OFF -DOCTISO_BUILD_PYTHON=OFF ${OCTISO_CMAKE_ARGS:-} >/dev/null
 cmake --build "$build" -j "${OCTISO_JOBS:-$(nproc)}" $(for t in $targets; do echo --target fuzz_$t; done)

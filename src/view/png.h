@@ -1,0 +1,17 @@
+// encode_png: a frame's 8-bit sRGB colour as PNG bytes in memory (OpenImageIO through an I/O
+// proxy, the encoder octiso-render's files come from), the viewer's frame format: lossless, so
+// the page shows exactly the pixels octiso-render writes (the end-to-end test compares them).
+#pragma once
+
+#include <string>
+
+#include "octiso/frame.h"
+
+namespace octiso::view {
+
+/// PNG of frame.rgb (width x height x 3). zlib level 1: at 1024^2 the default level costs more
+/// than the render, and the bytes only cross loopback. Throws Error(ErrorKind::Other) if the
+/// encoder fails.
+std::string encode_png(const Frame& frame);
+
+}  // namespace octiso::view

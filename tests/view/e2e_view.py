@@ -1,0 +1,194 @@
+#!/usr/bin/python3
+"""End-to-end test of octiso-view in headless Chromium (issue 20), ctest `ViewerEndToEnd`.
+
+Starts octiso-view on a synthetic volume, opens the page with Selenium, moves the isovalue slider
+with the keyboard and orbits with a mouse drag on the image, waits for the full frame of that
+input, and checks that the frame the page shows is, pixel for pixel, the image octiso-render
+writes for the command the page offers ("copy command"). Pixels are compared after decoding both
+PNGs (a small decoder below), and the page's displayed <img> is read back through a canvas too.
+
+    tests/view/e2e_view.py TOOLS_DIR
+
+Exit status 0 pass, 1 fail, 77 skip (chromium, chromedriver or python3-selenium missing); with
+OCTISO_REQUIRE_ALL=1 a missing piece fails instead (tests/test_util/skip.h, the same rule)."""
+import base64
+import os
+import select
+import shlex
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import zlib
+
+SKIP = 77
+
+
+def give_up(what):
+    if os.environ.get("OCTISO_REQUIRE_ALL", "") not in ("", "0"):
+        print(f"e2e_view: {what} (OCTISO_REQUIRE_ALL is set: a skip fails)")
+        sys.exit(1)
+    print(f"e2e_view: skipped: {what}")
+    sys.exit(SKIP)
+
+
+def decode_png(data):
+    """8-bit RGB or RGBA, non-interlaced PNG -> (width, height, bytes of RGB rows). Enough for what
+    OpenImageIO and Chromium write here; anything else is an error, not a guess."""
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError("not a PNG")
+    pos, idat, header = 8, b"", None
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat += body
+        elif kind == b"IEND":
+            break
+    width, height, depth, colour, _, _, interlace = header
+    if depth != 8 or colour not in (2, 6) or interlace != 0:
+        raise ValueError(f"unsupported PNG (depth {depth}, colour type {colour}, interlace {interlace})")
+    bpp = 3 if colour == 2 else 4
+    raw, stride = zlib.decompress(idat), width * bpp
+    out, prev = bytearray(), bytearray(stride)
+    for y in range(height):
+        filt, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0
+            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
+            if filt == 1:
+                line[i] = (line[i] + a) & 255
+            elif filt == 2:
+                line[i] = (line[i] + b) & 255
+            elif filt == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif filt == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+            elif filt != 0:
+                raise ValueError(f"bad PNG filter {filt}")
+        out += line if bpp == 3 else bytes(v for j, v in enumerate(line) if j % 4 != 3)
+        prev = line
+    return width, height, bytes(out)
+
+
+def main():
+    tools = sys.argv[1]
+    try:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.service import Service
+        from selenium.webdriver.common.action_chains import ActionChains
+        from selenium.webdriver.common.by import By
+        from selenium.webdriver.common.keys import Keys
+        from selenium.webdriver.support.ui import WebDriverWait
+    except ImportError:
+        give_up("python3-selenium is not installed")
+    chromium, driver_path = shutil.which("chromium"), shutil.which("chromedriver")
+    if not chromium or not driver_path:
+        give_up("chromium or chromium-driver is not installed")
+
+    work = tempfile.mkdtemp(prefix="octiso_e2e_view_")
+    viewer = driver = None
+    try:
+        oct_path = os.path.join(work, "ml.oct")
+        subprocess.run([f"{tools}/octiso-convert", "--synthetic", "marschner-lobb:41", "-o", oct_path],
+                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        viewer = subprocess.Popen([f"{tools}/octiso-view", oct_path, "--port", "0", "--threads", "2"],
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        ready, _, _ = select.select([viewer.stdout], [], [], 20)
+        if not ready:
+            raise AssertionError("octiso-view printed no URL")
+        line = viewer.stdout.readline()
+        url = line.split(" at ")[-1].strip()
+        assert url.startswith("http://127.0.0.1:"), line
+
+        options = webdriver.ChromeOptions()
+        options.binary_location = chromium
+        for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                     "--window-size=800,600", "--force-device-scale-factor=1", "--force-color-profile=srgb"):
+            options.add_argument(flag)
+        driver = webdriver.Chrome(service=Service(executable_path=driver_path), options=options)
+        driver.set_script_timeout(90)
+        driver.get(url)
+        wait = WebDriverWait(driver, 90)   # a bound, not a measurement: the ASan build renders slowly
+        settled = lambda d: d.execute_script("return window.octiso.settled && window.octiso.lastFrame !== null")
+        wait.until(settled)
+        first = driver.execute_script("return window.octiso.lastFrame.command")
+
+        # Isovalue: five steps right with the keyboard, as a user would nudge it.
+        iso = driver.find_element(By.ID, "iso")
+        iso.click()
+        iso_text = driver.find_element(By.ID, "iso-text")
+        iso_before = iso_text.text
+        iso.send_keys(Keys.ARROW_RIGHT * 5)
+        iso_after = iso_text.text   # what the user reads beside the slider
+        assert iso_after != iso_before, "the slider did not move"
+        # Orbit: a drag on the image (its centre is clear of the panel at 800x600).
+        image = driver.find_element(By.ID, "frame")
+        ActionChains(driver).move_to_element(image).click_and_hold().move_by_offset(60, 15) \
+            .move_by_offset(40, -30).release().perform()
+        wait.until(lambda d: settled(d) and d.execute_script("return window.octiso.lastFrame.command") != first)
+
+        shown = driver.execute_async_script("""
+            const done = arguments[arguments.length - 1];
+            const f = window.octiso.lastFrame;
+            const img = document.getElementById('frame');
+            const canvas = document.createElement('canvas');
+            canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
+            const g = canvas.getContext('2d');
+            g.drawImage(img, 0, 0);
+            const px = Array.from(g.getImageData(0, 0, canvas.width, canvas.height).data);
+            const reader = new FileReader();
+            reader.onload = () => done({png: reader.result.split(',')[1], command: f.command, iso: f.iso,
+                                        full: f.full, width: f.width, height: f.height, canvas: px,
+                                        natural: [img.naturalWidth, img.naturalHeight],
+                                        view: [window.innerWidth, window.innerHeight], errors: window.octiso.errors});
+            reader.readAsDataURL(f.blob);""")
+        assert shown["errors"] == 0, "the page showed an error"
+        assert shown["full"], "the settled frame is the full-resolution one"
+        assert [shown["width"], shown["height"]] == shown["view"], (shown["width"], shown["height"], shown["view"])
+        assert shown["natural"] == shown["view"], (shown["natural"], shown["view"])
+        assert shown["iso"] == iso_after, (shown["iso"], iso_after)
+        command = shown["command"]
+        assert f" --iso {iso_after} " in command, command
+
+        # The command the page offers, run as given (only the output name replaced).
+        args = shlex.split(command)
+        assert args[0] == "octiso-render" and args[1] == oct_path, args
+        out = os.path.join(work, "reference.png")
+        args = [f"{tools}/octiso-render"] + args[1:-1] + [out]
+        subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        ref_w, ref_h, ref = decode_png(open(out, "rb").read())
+        got_w, got_h, got = decode_png(base64.b64decode(shown["png"]))
+        assert (got_w, got_h) == (ref_w, ref_h) == tuple(shown["view"]), ((got_w, got_h), (ref_w, ref_h))
+        differing = sum(1 for i in range(0, len(ref), 3) if ref[i:i + 3] != got[i:i + 3])
+        assert differing == 0, f"{differing} of {ref_w * ref_h} pixels differ from octiso-render's image"
+        # What is on screen: the <img> drawn into a canvas (RGBA) has the same pixels.
+        canvas = bytes(v for j, v in enumerate(shown["canvas"]) if j % 4 != 3)
+        differing = sum(1 for i in range(0, len(ref), 3) if ref[i:i + 3] != canvas[i:i + 3])
+        assert differing == 0, f"{differing} pixels of the displayed image differ from octiso-render's image"
+        background = ref[0:3]
+        hit = sum(1 for i in range(0, len(ref), 3) if ref[i:i + 3] != background)
+        assert hit > ref_w * ref_h // 20, f"only {hit} pixels show the surface: a trivial frame proves little"
+        print(f"e2e_view: {ref_w}x{ref_h} frame at iso {iso_after} after an orbit equals octiso-render's "
+              f"({hit} surface pixels): {command}")
+        return 0
+    finally:
+        if driver is not None:
+            driver.quit()
+        if viewer is not None:
+            viewer.terminate()
+            try:
+                viewer.wait(10)
+            except subprocess.TimeoutExpired:
+                viewer.kill()
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
