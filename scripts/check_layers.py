@@ -10,7 +10,7 @@ import sys
 
 # Lowest first. A file belongs to the first layer whose prefix matches its path.
 LAYERS = [
-    ("base", ["include/octiso/error.h", "include/octiso/limits.h", "include/octiso/volume.h",
+    ("base", ["include/octiso/error.h", "include/octiso/inline.h", "include/octiso/limits.h", "include/octiso/volume.h",
               "include/octiso/tiles.h", "include/octiso/frame.h", "include/octiso/camera.h",
               "include/octiso/root_finder.h", "include/octiso/step_pattern.h", "include/octiso/output_guard.h",
               "include/octiso/version.h", "src/math/", "src/util/"]),

@@ -101,7 +101,9 @@ Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_by
 }
 
 std::string render_command(const std::string& path, const Camera& camera, double iso, uint32_t step, uint32_t step_count) {
-    std::string c = "octiso-render " + shell_quote(path) + " --iso " + exact(iso);
+    // The viewer shows the Renderer's own colour (headlight); octiso-render's default is the light
+    // kit (deferred shading), so the command names the headlight to reproduce the frame exactly.
+    std::string c = "octiso-render " + shell_quote(path) + " --iso " + exact(iso) + " --shading headlight";
     c += " --eye " + vec3(camera.eye) + " --look " + vec3(camera.look) + " --up " + vec3(camera.up);
     c += " --fov " + exact(camera.fov_deg) + " --size " + std::to_string(camera.width) + "x" + std::to_string(camera.height);
     // octiso-render renders step k of a series with --steps k:k and a name pattern.
