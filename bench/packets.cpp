@@ -307,15 +307,13 @@ int run_packets(cli::Args& args) {
     for (const CaseRow& r : cases) {
         std::vector<std::string> cells{r.dataset, fmt(r.iso, 1), std::to_string(r.image) + "^2", std::to_string(r.threads),
                                        std::to_string(r.hits)};
-        double single = NAN, best = INFINITY, mesh8 = NAN, before = NAN;
+        double best = INFINITY, mesh8 = NAN, before = NAN;
         for (const auto& [name, s] : r.min_seconds) {
             cells.push_back(fmt(s * 1e3, 1));
             if (name == "octiso single, Embree") before = s;
-            if (name == "octiso single") single = s;
             if (name.rfind("octiso packets", 0) == 0) best = std::min(best, s);
             if (name.rfind("mesh 8-ray", 0) == 0) mesh8 = std::isnan(mesh8) ? s : std::min(mesh8, s);
         }
-        (void)single;
         cells.push_back(fmt(before / best, 2) + " x");
         cells.push_back(std::isnan(mesh8) ? "-" : fmt(mesh8 / best, 2) + " x");
         bool same = true;

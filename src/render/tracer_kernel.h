@@ -3,7 +3,7 @@
 // kernel (kernel_baseline.cpp, the default x86-64-v2 flags) and the AVX2 kernel (kernel_avx2.cpp,
 // -mavx2 -mfma -ffp-contract=off) are the same source (kernel_impl.h) in different ISA
 // namespaces (util/isa.h). FMA contraction is off, so both do the same IEEE operations in the
-// same order: frames are bit-identical across ISAs (tests/render/isa_test.cpp). The renderer only
+// same order: frames are bit-identical across ISAs (tests/render/packet_test.cpp). The renderer only
 // sees function pointers, called once per packet of up to 8 rays, never per cell.
 #pragma once
 

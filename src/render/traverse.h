@@ -72,11 +72,12 @@ public:
         return w.hit;
     }
 
-    /// The most rays one trace_packet() call takes (one rtcIntersect8 packet, one row of 8 pixels).
+    /// The most rays one trace_packet() call takes (one rtcIntersect8 packet, 4x2 pixels).
     static constexpr int kMaxPacket = 8;
     /// A packet keeps traversing a subtree together while at least this many of its lanes enter
     /// it; fewer lanes continue as single rays. Measured by `octiso-bench packets` (BENCHMARKS.md,
-    /// packet section): 2 was fastest of 1..4 on the MRI templates and plume at 512^2.
+    /// packet section): primary rays are flat within 2 % from 1 to 4 lanes; at 2, incoherent rays
+    /// lost 5-10 % against single rays, at 4 they stay closest.
     static constexpr int kDefaultMinPacketLanes = 4;
     /// For the benchmark's A/B of the threshold and for tests that force one path; not thread-safe
     /// against a frame in flight.
@@ -142,39 +143,51 @@ private:
         const InteriorNode<T>& n = tree_.node(d, index);
         const uint32_t half = tree_.child_bit(d);
         if constexpr (Recorder::kOn) recorder_.enter_node(d, index, o, 2 * half, t0, t1);
+        bool hit = false;
+        for_each_child_piece(w.ray, o, half, t0, t1, [&](int c, double t_cur, double t_next) {
+            if constexpr (Recorder::kOn)
+                if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count))
+                    recorder_.cull(d, c, child_origin_of(o, c, half), half, double(n.min[c]), double(n.max[c]), t_cur,
+                                   t_next);
+            if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) return false;
+            const Coord co = child_origin_of(o, c, half);
+            if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
+            else if (d == tree_.dmax() - 2) {
+                CapBlocks blocks;
+                hit = cap(w, w.trace, n.child_index(c), co, t_cur, t_next, blocks);
+            } else hit = node(w, d + 1, n.child_index(c), co, t_cur, t_next);
+            return hit;
+        });
+        return hit;
+    }
+
+    /// The children of the node at `o` (children of side `half`) that ray `r` crosses on
+    /// [t0, t1), in the order it crosses them: visit(c, t_cur, t_next) for each non-empty piece
+    /// [t_cur, t_next), until visit returns true. The split times are the ray's mid-plane times
+    /// (plane_t), ordered by a 3-element sorting network and folded by a running max: the one
+    /// arithmetic both node() and packet_node() split at, so a packet lane gets its single-ray
+    /// pieces bit for bit.
+    template <class Visit>
+    OCTISO_ALWAYS_INLINE bool for_each_child_piece(const IndexRay& r, const Coord& o, uint32_t half, double t0,
+                                                   double t1, Visit&& visit) const {
         const uint32_t origin[3] = {o.x, o.y, o.z};
         double tm[3];
         int c = 0;
         for (int a = 0; a < 3; ++a) {
             const double mid = double(origin[a] + half);
-            tm[a] = w.ray.plane_t(a, mid);
-            if (upper_at(w.ray, a, mid, tm[a], t0)) c |= 4 >> a;
+            tm[a] = r.plane_t(a, mid);
+            if (upper_at(r, a, mid, tm[a], t0)) c |= 4 >> a;
         }
-        // Axes in the order the ray crosses their mid-planes (a 3-element sorting network).
         int order[3] = {0, 1, 2};
         if (tm[order[1]] < tm[order[0]]) std::swap(order[0], order[1]);
         if (tm[order[2]] < tm[order[1]]) std::swap(order[1], order[2]);
         if (tm[order[1]] < tm[order[0]]) std::swap(order[0], order[1]);
-
         double t_cur = t0;
         for (int i = 0; i <= 3; ++i) {
             double t_next = t1;
             if (i < 3 && tm[order[i]] > t0 && tm[order[i]] < t1) t_next = tm[order[i]];
             else if (i < 3) continue;   // this axis is not crossed inside [t0, t1)
-            if constexpr (Recorder::kOn)
-                if (t_next > t_cur && !n.may_contain_any(c, scene_.isovalues, scene_.iso_count))
-                    recorder_.cull(d, c, child_origin_of(o, c, half), half, double(n.min[c]), double(n.max[c]), t_cur,
-                                   t_next);
-            if (t_next > t_cur && n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) {
-                const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
-                bool hit;
-                if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
-                else if (d == tree_.dmax() - 2) {
-                    CapBlocks blocks;
-                    hit = cap(w, w.trace, n.child_index(c), co, t_cur, t_next, blocks);
-                } else hit = node(w, d + 1, n.child_index(c), co, t_cur, t_next);
-                if (hit) return true;
-            }
+            if (t_next > t_cur && visit(c, t_cur, t_next)) return true;
             if (i == 3) break;
             t_cur = std::max(t_cur, t_next);
             c ^= 4 >> order[i];
@@ -215,38 +228,17 @@ private:
         p.trace[d] = index;
         const InteriorNode<T>& n = tree_.node(d, index);
         const uint32_t half = tree_.child_bit(d);
-        const uint32_t origin[3] = {o.x, o.y, o.z};
-        // Per lane, the children it crosses and its piece of each, by exactly node()'s arithmetic
-        // (mid-plane times, the sorting network, the running max); lanes_in[c]: who enters child c.
+        // Per lane, the children it crosses and its piece of each, by node()'s own walk
+        // (for_each_child_piece); lanes_in[c]: who enters child c.
         unsigned lanes_in[8] = {};
         double c0[8][kMaxPacket], c1[8][kMaxPacket];
         for (unsigned m = active; m; m &= m - 1) {
             const int k = std::countr_zero(m);
-            const IndexRay& r = p.lane[k].ray;
-            double tm[3];
-            int c = 0;
-            for (int a = 0; a < 3; ++a) {
-                const double mid = double(origin[a] + half);
-                tm[a] = r.plane_t(a, mid);
-                if (upper_at(r, a, mid, tm[a], t0[k])) c |= 4 >> a;
-            }
-            int order[3] = {0, 1, 2};
-            if (tm[order[1]] < tm[order[0]]) std::swap(order[0], order[1]);
-            if (tm[order[2]] < tm[order[1]]) std::swap(order[1], order[2]);
-            if (tm[order[1]] < tm[order[0]]) std::swap(order[0], order[1]);
-            double t_cur = t0[k];
-            for (int i = 0; i <= 3; ++i) {
-                double t_next = t1[k];
-                if (i < 3 && tm[order[i]] > t0[k] && tm[order[i]] < t1[k]) t_next = tm[order[i]];
-                else if (i < 3) continue;
-                if (t_next > t_cur) {
-                    lanes_in[c] |= 1u << k;
-                    c0[c][k] = t_cur, c1[c][k] = t_next;
-                }
-                if (i == 3) break;
-                t_cur = std::max(t_cur, t_next);
-                c ^= 4 >> order[i];
-            }
+            for_each_child_piece(p.lane[k].ray, o, half, t0[k], t1[k], [&](int c, double lo, double hi) {
+                lanes_in[c] |= 1u << k;
+                c0[c][k] = lo, c1[c][k] = hi;
+                return false;
+            });
         }
         for (int i = 0; i < 8 && active; ++i) {
             const unsigned c = unsigned(i ^ flip);

@@ -52,8 +52,8 @@ TEST_F(TraversalCli, EveryTraversalAndIsaDrawsTheSameBytes) {
         ASSERT_EQ(r.status, 0) << f << ": " << r.err;
         EXPECT_EQ(bytes_of(dir_.file(name) + ".png"), bytes_of(dir_.file("default.png"))) << f;
         const FloatImage depth = read_image(dir_.file(name) + ".exr"), base_depth = read_image(dir_.file("default.exr"));
+        ASSERT_EQ(depth.pixels.size(), base_depth.pixels.size()) << f;
         EXPECT_EQ(0, std::memcmp(depth.pixels.data(), base_depth.pixels.data(), depth.pixels.size() * sizeof(float))) << f;
-        EXPECT_EQ(depth.pixels.size(), base_depth.pixels.size()) << f;
     }
     const ToolRun single = render("--traversal single --isa baseline", "named");
     EXPECT_NE(single.out.find("\"traversal\":\"single\""), std::string::npos) << single.out;
