@@ -15,15 +15,6 @@ namespace octiso {
 
 namespace {
 
-template <typename U> void swap_all(std::byte* p, uint64_t n) {
-    for (uint64_t i = 0; i < n; ++i) {
-        unsigned char b[sizeof(U)];
-        std::memcpy(b, p + i * sizeof(U), sizeof(U));
-        std::reverse(b, b + sizeof(U));
-        std::memcpy(p + i * sizeof(U), b, sizeof(U));
-    }
-}
-
 class NiftiStream final : public VolumeStream {
 public:
     NiftiStream(const std::string& path, const io::NiftiHeader& h, gzFile f)
@@ -47,12 +38,7 @@ protected:
             if (n == 0) throw Error(source(), "file ended early (fewer voxels than the header declares)");
             done += uint64_t(n);
         }
-        if (swap_) {
-            const size_t s = scalar_type_bytes(type());
-            if (s == 2) swap_all<uint16_t>(dst, bytes / 2);
-            else if (s == 4) swap_all<uint32_t>(dst, bytes / 4);
-            else if (s == 8) swap_all<uint64_t>(dst, bytes / 8);
-        }
+        if (swap_) swap_scalars_in_place(dst, bytes, scalar_type_bytes(type()));
     }
 
 private:

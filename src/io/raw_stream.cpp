@@ -18,17 +18,6 @@ namespace {
 
 std::string dims_text(Dims d) { return std::to_string(d.x) + "," + std::to_string(d.y) + "," + std::to_string(d.z); }
 
-template <typename U> void swap_all(std::byte* p, uint64_t n) {
-    for (uint64_t i = 0; i < n; ++i) {
-        U u;
-        std::memcpy(&u, p + i * sizeof(U), sizeof(U));
-        if constexpr (sizeof(U) == 2) u = __builtin_bswap16(u);
-        else if constexpr (sizeof(U) == 4) u = __builtin_bswap32(u);
-        else u = __builtin_bswap64(u);
-        std::memcpy(p + i * sizeof(U), &u, sizeof(U));
-    }
-}
-
 class RawStream final : public VolumeStream {
 public:
     RawStream(const std::string& path, Dims dims, ScalarType type, int fd, uint64_t offset, bool swap)
@@ -49,12 +38,7 @@ protected:
         }
         pos_ += bytes;
         read_ += bytes;
-        if (swap_) {
-            const size_t s = scalar_type_bytes(type());
-            if (s == 2) swap_all<uint16_t>(dst, bytes / 2);
-            else if (s == 4) swap_all<uint32_t>(dst, bytes / 4);
-            else if (s == 8) swap_all<uint64_t>(dst, bytes / 8);
-        }
+        if (swap_) swap_scalars_in_place(dst, bytes, scalar_type_bytes(type()));
     }
 
 private:

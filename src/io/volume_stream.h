@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 
@@ -90,5 +91,22 @@ bool is_streamable(const std::string& path, const RawOptions& options);
 /// overrides and placement check. Throws Error naming the file or flag; also when the format
 /// cannot be streamed (check is_streamable first).
 std::unique_ptr<VolumeStream> open_volume_stream(const std::string& path, const RawOptions& options);
+
+/// Reverses the bytes of each of the `bytes / scalar_bytes` scalars at p, in place: a slab read
+/// from a file of the other byte order, before it is handed out (both stream readers).
+inline void swap_scalars_in_place(std::byte* p, uint64_t bytes, size_t scalar_bytes) {
+    auto swap_all = [&](auto tag) {
+        using U = decltype(tag);
+        for (uint64_t i = 0; i < bytes / sizeof(U); ++i) {
+            U u;
+            std::memcpy(&u, p + i * sizeof(U), sizeof(U));
+            u = VolumeView<U>::byte_swapped(u);
+            std::memcpy(p + i * sizeof(U), &u, sizeof(U));
+        }
+    };
+    if (scalar_bytes == 2) swap_all(uint16_t{});
+    else if (scalar_bytes == 4) swap_all(uint32_t{});
+    else if (scalar_bytes == 8) swap_all(uint64_t{});
+}
 
 }  // namespace octiso
