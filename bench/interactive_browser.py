@@ -21,12 +21,49 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
+
+
+# Per-phase timers of one frame: the server's (X-Octiso-Stats) and the page's (lastFrame.phases).
+kPhases = ("server wait", "server encode", "server handler", "page headers", "page drawable")
 
 
 def percentile(values, p):
     """The nearest-rank percentile, as octiso-bench interactive computes it."""
     v = sorted(values)
     return v[max(0, min(len(v) - 1, math.ceil(p * len(v)) - 1))]
+
+
+def descendants(pid):
+    """pid and every process below it (chromedriver -> chromium's browser, renderer, GPU ...)."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as f:
+                    ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            children.setdefault(ppid, []).append(int(entry))
+    out, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        out.append(p)
+        todo += children.get(p, [])
+    return out
+
+
+def cpu_seconds(pids):
+    """User + system CPU seconds of the live processes in pids (threads included)."""
+    total = 0
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+        except (OSError, IndexError, ValueError):
+            pass
+    return total
 
 
 def main():
@@ -39,7 +76,13 @@ def main():
     ap.add_argument("--results", default=os.path.join(tempfile.gettempdir(), "octiso-bench-results"))
     ap.add_argument("--volume", default="/usr/share/mricron/templates/ch2better.nii.gz")
     ap.add_argument("--iso", type=float, default=80.5)
+    ap.add_argument("--encodings", default="rgba",
+                    help="the page's frame encodings, comma-separated (rgba: its loopback default; png); "
+                         "more than one alternates them change by change")
     a = ap.parse_args()
+    encodings = a.encodings.split(",")
+    if not encodings or any(e not in ("rgba", "png") for e in encodings):
+        ap.error("--encodings: rgba and/or png")
     changes = a.changes or (4 if a.quick else 60)
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
@@ -62,6 +105,7 @@ def main():
                      "--window-size=1200,1200", "--force-device-scale-factor=1"):
             options.add_argument(flag)
         driver = webdriver.Chrome(service=Service(executable_path=shutil.which("chromedriver")), options=options)
+        chromium_pid = driver.service.process.pid
         for side in [int(s) for s in a.sizes.split(",")]:
             driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
                                    {"width": side, "height": side, "deviceScaleFactor": 1, "mobile": False})
@@ -69,26 +113,55 @@ def main():
             wait = WebDriverWait(driver, 120)
             wait.until(lambda d: d.execute_script("return window.octiso.settled"))
             start = driver.execute_script("return Number(document.getElementById('iso').value)")
-            latencies, renders = [], []
-            for i in range(-2, changes):   # two warm-up changes
+            samples = {e: {"latency": [], "render": [], "shown": [], **{k: [] for k in kPhases}} for e in encodings}
+            cpu_before = (cpu_seconds([viewer.pid]), cpu_seconds(descendants(chromium_pid)))
+            wall_start = time.monotonic()
+            # Changes alternate between the encodings (A/B in one run, same load), each encoding
+            # seeing the same isovalues: change k of every encoding is slider position k.
+            for i in range(-2 * len(encodings), changes * len(encodings)):   # two warm-up changes each
+                encoding, k = encodings[i % len(encodings)], i // len(encodings)
                 seq = driver.execute_script("""
+                    window.octiso.encoding = arguments[1];
                     const s = document.getElementById('iso');
                     s.value = String(arguments[0]);
                     s.dispatchEvent(new Event('change'));
-                    return window.octiso.lastFrame.seq;""", start + (i + 2) % 20 - 10)   # a drag of 20 slider positions
+                    return window.octiso.lastFrame.seq;""", start + (k + 2) % 20 - 10, encoding)   # a drag of 20 slider positions
                 wait.until(lambda d: d.execute_script(
-                    "return window.octiso.settled && window.octiso.lastFrame.seq > arguments[0]", seq))
-                frame = driver.execute_script("const f = window.octiso.lastFrame; return [f.latencyMs, f.width, f.height, f.stats.seconds];")
-                assert frame[1] == side and frame[2] == side, frame
-                if i >= 0:
-                    latencies.append(frame[0])
-                    renders.append(frame[3] * 1e3)
-            rows.append({"image": side, "changes": changes, "p50_ms": percentile(latencies, 0.5),
-                         "p95_ms": percentile(latencies, 0.95), "max_ms": max(latencies),
-                         "render_p50_ms": percentile(renders, 0.5)})
-            print(f"{side}^2: isovalue change -> frame decoded in Chromium: p50 {rows[-1]['p50_ms']:.1f} ms, "
-                  f"p95 {rows[-1]['p95_ms']:.1f} ms, max {rows[-1]['max_ms']:.1f} ms, render alone p50 "
-                  f"{rows[-1]['render_p50_ms']:.1f} ms ({changes} changes)")
+                    "const f = window.octiso.lastFrame;"
+                    "return window.octiso.settled && f.seq > arguments[0] && f.shownMs !== null", seq))
+                frame = driver.execute_script("""
+                    const f = window.octiso.lastFrame, s = f.stats, p = f.phases;
+                    return [f.encoding, f.width, f.height, f.latencyMs, s.seconds * 1e3, f.shownMs, s.wait * 1e3,
+                            s.encode * 1e3, s.server * 1e3, p.headers, p.decoded];""")
+                assert frame[:3] == [encoding, side, side], frame
+                if k >= 0:
+                    for name, v in zip(("latency", "render", "shown") + kPhases, frame[3:]):
+                        samples[encoding][name].append(v)
+            wall = time.monotonic() - wall_start
+            n_frames = (changes + 2) * len(encodings)
+            cpu = {"viewer_cpu_ms_per_frame": (cpu_seconds([viewer.pid]) - cpu_before[0]) / n_frames * 1e3,
+                   "chromium_cpu_ms_per_frame": (cpu_seconds(descendants(chromium_pid)) - cpu_before[1]) / n_frames * 1e3,
+                   "wall_ms_per_frame": wall / n_frames * 1e3}
+            for encoding in encodings:
+                m = samples[encoding]
+                row = {"image": side, "encoding": encoding, "changes": changes,
+                       "p50_ms": percentile(m["latency"], 0.5), "p95_ms": percentile(m["latency"], 0.95),
+                       "max_ms": max(m["latency"]),
+                       "shown_p50_ms": percentile(m["shown"], 0.5), "shown_p95_ms": percentile(m["shown"], 0.95),
+                       "render_p50_ms": percentile(m["render"], 0.5), "render_p95_ms": percentile(m["render"], 0.95),
+                       "phases_p50_ms": {k: percentile(m[k], 0.5) for k in kPhases},
+                       "phases_p95_ms": {k: percentile(m[k], 0.95) for k in kPhases}, **cpu}
+                rows.append(row)
+                print(f"{side}^2 {encoding}: isovalue change -> frame drawable in Chromium: p50 {row['p50_ms']:.1f} ms, "
+                      f"p95 {row['p95_ms']:.1f} ms, max {row['max_ms']:.1f} ms; painted (next animation frame) p50 "
+                      f"{row['shown_p50_ms']:.1f} ms, p95 {row['shown_p95_ms']:.1f} ms; render alone p50 "
+                      f"{row['render_p50_ms']:.1f} ms, p95 {row['render_p95_ms']:.1f} ms ({changes} changes)")
+                print("  phases p50 / p95 ms (server: wait behind another render, encode, whole handler;"
+                      " page: since fetch sent):")
+                for k in kPhases:
+                    print(f"    {k:>15}: {row['phases_p50_ms'][k]:7.1f} / {row['phases_p95_ms'][k]:7.1f}")
+            print(f"  CPU per frame (both encodings): octiso-view {cpu['viewer_cpu_ms_per_frame']:.1f} ms, "
+                  f"Chromium and chromedriver {cpu['chromium_cpu_ms_per_frame']:.1f} ms, wall {cpu['wall_ms_per_frame']:.1f} ms")
     finally:
         if driver is not None:
             driver.quit()
