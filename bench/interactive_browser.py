@@ -79,6 +79,9 @@ def main():
     ap.add_argument("--encodings", default="rgba",
                     help="the page's frame encodings, comma-separated (rgba: its loopback default; png); "
                          "more than one alternates them change by change")
+    ap.add_argument("--gesture", choices=("release", "nudge"), default="release",
+                    help="release: a 'change' alone (the slider let go); nudge: 'input' then 'change' in one "
+                         "task, as a keyboard step on the slider fires them")
     a = ap.parse_args()
     encodings = a.encodings.split(",")
     if not encodings or any(e not in ("rgba", "png") for e in encodings):
@@ -112,6 +115,7 @@ def main():
             driver.get(url)
             wait = WebDriverWait(driver, 120)
             wait.until(lambda d: d.execute_script("return window.octiso.settled"))
+            driver.set_script_timeout(120)
             start = driver.execute_script("return Number(document.getElementById('iso').value)")
             samples = {e: {"latency": [], "render": [], "shown": [], **{k: [] for k in kPhases}} for e in encodings}
             cpu_before = (cpu_seconds([viewer.pid]), cpu_seconds(descendants(chromium_pid)))
@@ -120,19 +124,24 @@ def main():
             # seeing the same isovalues: change k of every encoding is slider position k.
             for i in range(-2 * len(encodings), changes * len(encodings)):   # two warm-up changes each
                 encoding, k = encodings[i % len(encodings)], i // len(encodings)
-                seq = driver.execute_script("""
-                    window.octiso.encoding = arguments[1];
+                # One asynchronous script per change, answered from the page's own hook at the
+                # animation frame that paints the new full frame: WebDriver does not poll the page
+                # (each poll would run in Chromium while octiso-view renders on the same 2 cores).
+                frame = driver.execute_async_script("""
+                    const [position, encoding, gesture, done] = arguments;
+                    const before = window.octiso.lastFrame.seq;
+                    window.octiso.onShown = (f) => {
+                      if (!(window.octiso.settled && f.full && f.seq > before)) return;
+                      window.octiso.onShown = null;
+                      const s = f.stats, p = f.phases;
+                      done([f.encoding, f.width, f.height, f.latencyMs, s.seconds * 1e3, f.shownMs, s.wait * 1e3,
+                            s.encode * 1e3, s.server * 1e3, p.headers, p.decoded]);
+                    };
+                    window.octiso.encoding = encoding;
                     const s = document.getElementById('iso');
-                    s.value = String(arguments[0]);
-                    s.dispatchEvent(new Event('change'));
-                    return window.octiso.lastFrame.seq;""", start + (k + 2) % 20 - 10, encoding)   # a drag of 20 slider positions
-                wait.until(lambda d: d.execute_script(
-                    "const f = window.octiso.lastFrame;"
-                    "return window.octiso.settled && f.seq > arguments[0] && f.shownMs !== null", seq))
-                frame = driver.execute_script("""
-                    const f = window.octiso.lastFrame, s = f.stats, p = f.phases;
-                    return [f.encoding, f.width, f.height, f.latencyMs, s.seconds * 1e3, f.shownMs, s.wait * 1e3,
-                            s.encode * 1e3, s.server * 1e3, p.headers, p.decoded];""")
+                    s.value = String(position);
+                    if (gesture === 'nudge') s.dispatchEvent(new Event('input'));
+                    s.dispatchEvent(new Event('change'));""", start + (k + 2) % 20 - 10, encoding, a.gesture)   # a drag of 20 slider positions
                 assert frame[:3] == [encoding, side, side], frame
                 if k >= 0:
                     for name, v in zip(("latency", "render", "shown") + kPhases, frame[3:]):
@@ -174,7 +183,7 @@ def main():
     os.makedirs(a.results, exist_ok=True)
     path = os.path.join(a.results, "interactive_browser.json")
     with open(path, "w") as f:
-        json.dump({"volume": a.volume, "iso": a.iso, "threads": a.threads, "load_average_1min": load,
+        json.dump({"volume": a.volume, "iso": a.iso, "threads": a.threads, "gesture": a.gesture, "load_average_1min": load,
                    "browser": "headless chromium", "rows": rows}, f, indent=1)
     print(f"wrote {path} (load average {load})")
     return 0

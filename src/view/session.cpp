@@ -137,6 +137,9 @@ FrameReply ViewSession::render(const FrameRequest& request) {
     RenderOptions options;
     options.isovalues = {request.iso};
     options.threads = threads_;
+    // The kernel directly, without Embree's dispatch: the same pixels (RenderPaths.
+    // EmbreeAndDirectGiveIdenticalFrames), 1-5 % less per frame (BENCHMARKS.md, packets).
+    options.use_embree = false;
     std::unique_ptr<Renderer>& renderer = renderers_[request.step];
     if (!renderer) renderer = std::make_unique<Renderer>(AnyOctree::step(file_, request.step).make_renderer(options));
     else renderer->set_options(options);   // validates the isovalue against the file's iso-range
