@@ -1,16 +1,22 @@
 #!/usr/bin/python3
-"""octiso-view in headless Chromium: latency from an isovalue change to the new frame decoded in
-the browser (issue 20), the page's own measurement (window.octiso.lastFrame.latencyMs: fetch sent
-until the PNG is decoded by the browser, before paint). Companion of `octiso-bench interactive`,
-which measures the same server with a C++ client; this one includes the browser's fetch and decode.
+"""octiso-view in headless Chromium: latency from an isovalue change to the new frame in the
+browser (issue 20), the page's own measurement (window.octiso.lastFrame): latencyMs is fetch sent
+until the frame is drawable (raw RGBA wrapped as ImageData, or a PNG decoded) and put on the
+canvas; shownMs is the next animation frame, the one that paints it. Companion of `octiso-bench
+interactive`, which measures the same server with a C++ client; this one includes the browser.
 
     bench/interactive_browser.py --tools build [--sizes 512,1024] [--changes N] [--threads 2]
+                                 [--encodings rgba[,png]] [--gesture release|nudge]
                                  [--quick] [--results DIR]
 
 ch2better (/usr/share/mricron/templates/ch2better.nii.gz, converted with octiso-convert) at
 isovalues 80.5 +- a few slider positions, the default three-quarter view, the viewport set to each
 size exactly (DevTools device metrics). Each change is one slider release (a 'change' event: the
-page asks for the full frame at once); the next change is made when that frame is shown. Writes
+page asks for the full frame at once; --gesture nudge sends 'input' first, as a keyboard step
+does); the next change is made when that frame is painted. With two encodings the changes
+alternate between them (an A/B in one run, under the same load). Per-phase timers: the server's
+(wait behind another render, encode, whole handler) and the page's (headers received, drawable),
+p50 and p95, and the CPU time octiso-view and Chromium took per frame. Writes
 DIR/interactive_browser.json (default $TMPDIR/octiso-bench-results)."""
 import argparse
 import json
