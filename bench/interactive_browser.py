@@ -6,14 +6,14 @@ canvas; shownMs is the next animation frame, the one that paints it. Companion o
 interactive`, which measures the same server with a C++ client; this one includes the browser.
 
     bench/interactive_browser.py --tools build [--sizes 512,1024] [--changes N] [--threads 2]
-                                 [--encodings rgba[,png]] [--gesture release|nudge]
+                                 [--encodings rgba[,png]] [--gesture release|nudge] [--gap-ms MS]
                                  [--quick] [--results DIR]
 
 ch2better (/usr/share/mricron/templates/ch2better.nii.gz, converted with octiso-convert) at
 isovalues 80.5 +- a few slider positions, the default three-quarter view, the viewport set to each
 size exactly (DevTools device metrics). Each change is one slider release (a 'change' event: the
 page asks for the full frame at once; --gesture nudge sends 'input' first, as a keyboard step
-does); the next change is made when that frame is painted. With two encodings the changes
+does); the next change is made --gap-ms (100) after that frame is painted. With two encodings the changes
 alternate between them (an A/B in one run, under the same load). Per-phase timers: the server's
 (wait behind another render, encode, whole handler) and the page's (headers received, drawable),
 p50 and p95, and the CPU time octiso-view and Chromium took per frame. Writes
@@ -88,6 +88,10 @@ def main():
     ap.add_argument("--gesture", choices=("release", "nudge"), default="release",
                     help="release: a 'change' alone (the slider let go); nudge: 'input' then 'change' in one "
                          "task, as a keyboard step on the slider fires them")
+    ap.add_argument("--gap-ms", type=float, default=100,
+                    help="idle time between a frame painted and the next change (default 100: a person "
+                         "does not release the slider twice within a paint; 0 makes Chromium's compositing "
+                         "of one frame overlap the next frame's render)")
     a = ap.parse_args()
     encodings = a.encodings.split(",")
     if not encodings or any(e not in ("rgba", "png") for e in encodings):
@@ -149,6 +153,7 @@ def main():
                     if (gesture === 'nudge') s.dispatchEvent(new Event('input'));
                     s.dispatchEvent(new Event('change'));""", start + (k + 2) % 20 - 10, encoding, a.gesture)   # a drag of 20 slider positions
                 assert frame[:3] == [encoding, side, side], frame
+                time.sleep(a.gap_ms / 1e3)   # the paint of this frame ends before the next change
                 if k >= 0:
                     for name, v in zip(("latency", "render", "shown") + kPhases, frame[3:]):
                         samples[encoding][name].append(v)
@@ -189,7 +194,8 @@ def main():
     os.makedirs(a.results, exist_ok=True)
     path = os.path.join(a.results, "interactive_browser.json")
     with open(path, "w") as f:
-        json.dump({"volume": a.volume, "iso": a.iso, "threads": a.threads, "gesture": a.gesture, "load_average_1min": load,
+        json.dump({"volume": a.volume, "iso": a.iso, "threads": a.threads, "gesture": a.gesture, "gap_ms": a.gap_ms,
+                   "load_average_1min": load,
                    "browser": "headless chromium", "rows": rows}, f, indent=1)
     print(f"wrote {path} (load average {load})")
     return 0
