@@ -20,11 +20,12 @@ inline constexpr size_t kMaxValueLength = 64;               ///< characters of o
 inline constexpr double kMaxElevationDeg = 89.0;            ///< |elevation| < 90 keeps z-up defined
 inline constexpr double kMinZoom = 0.05, kMaxZoom = 50.0;
 
-/// How a frame's pixels travel. png: lossless and compact (OpenImageIO, zlib level 1), for a page
-/// on another machine and for saving; rgba: the tile loop's colour as raw 8-bit RGBA rows (alpha
-/// 255), which the page wraps as ImageData without decoding. On loopback rgba is the faster one:
-/// at 512^2 on ch2better the PNG encode took 16 ms p50 and the browser's decode 7 ms, the raw
-/// megabyte crosses loopback in about 1 ms (bench/interactive_browser.py, BENCHMARKS.md viewer).
+/// How a frame's pixels travel. png: lossless and compact (OpenImageIO, zlib level 1; 105 KB for
+/// ch2better at 512^2), for a page on another machine; rgba: the tile loop's colour as raw 8-bit
+/// RGBA rows (alpha 255, 1 MB at 512^2), which the page wraps as ImageData without decoding. On
+/// loopback rgba is the faster one: at 512^2 the PNG encode took 16-25 ms p50 and Chromium's
+/// decode 5-7 ms, the raw body arrives and is wrapped in about 4 ms (bench/interactive_browser.py
+/// --encodings rgba,png, BENCHMARKS.md viewer section).
 enum class FrameEncoding { png, rgba };
 
 /// One frame asked for: the camera of orbit_camera(dims, placement, width, height, azimuth_deg,
