@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "cli/common/json.h"
 #include "cli/common/output_path.h"
 #include "cli/common/progress.h"
@@ -100,7 +101,7 @@ uint64_t parse_memory(const std::string& text) {
 
 /// The flags that say where the steps come from, in the order they are checked (so that of
 /// several bad flags, the same one is named first every time).
-ConvertSource parse_source(cli::Args& args) {
+ConvertSource parse_source(const cli::Flags& args) {
     const auto synthetic = args.value("--synthetic");
     const auto steps = args.value("--steps");
     const auto dims = args.value("--dims");
@@ -257,11 +258,14 @@ void write_human(std::ostream& os, const ConvertReport& r, const std::optional<s
 
 /// --synthetic sparse-spheres:N (f32, N^3, N >= 64): built directly as an octree, no dense array
 /// (src/octree/sparse_synthetic.h), so N may be 16384 or more. Only -o and --json apply.
-int convert_sparse_spheres(cli::Args& args, uint32_t n) {
+int convert_sparse_spheres(const cli::Flags& args, uint32_t n) {
     const bool json = args.flag("--json");
-    const auto out = args.value("--output", "-o");
-    args.value("--synthetic");
-    args.finish();
+    const auto out = args.value("--output");
+    for (const std::string& flag : args.given())
+        if (flag != "--output" && flag != "--synthetic")
+            throw Error(flag, "does not apply to --synthetic sparse-spheres (only -o and --json do)");
+    if (args.flag("--in-memory")) throw Error("--in-memory", "does not apply to --synthetic sparse-spheres (only -o and --json do)");
+    if (!args.positional().empty()) throw Error(args.positional()[0], "give either INPUT or --synthetic, not both");
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
     cli::check_output_file(*out, "-o");   // before the work, naming the user's path
     const ConvertReport r = octiso::convert(ConvertSource::sparse_spheres(n), *out, BuildOptions{});
@@ -280,20 +284,24 @@ int convert_sparse_spheres(cli::Args& args, uint32_t n) {
 }
 
 int run(std::vector<std::string>& argv) {
-    cli::Args args(argv);
-    if (args.flag("--help") || args.flag("-h")) {
-        std::cout << kUsage;
-        return 0;
-    }
+    // --help wins over every other argument, as --version does in run_main.
+    for (const std::string& a : argv)
+        if (a == "--help" || a == "-h") {
+            std::cout << kUsage;
+            return 0;
+        }
     if (argv.empty()) {   // the same in every tool: the help, as a usage error
         std::cerr << kUsage;
         return 2;
     }
-    for (size_t i = 0; i + 1 < argv.size(); ++i)   // sparse-spheres never makes a dense array
-        if (argv[i] == "--synthetic")
-            if (const uint32_t n = parse_sparse_spheres(argv[i + 1])) return convert_sparse_spheres(args, n);
+    const cli::Flags args(argv,
+                          {"-o,--output", "--synthetic", "--steps", "--dims", "--type", "--endian", "--offset", "--spacing",
+                           "--origin", "--array", "--iso-range", "--tolerance", "--nan-as", "--threads", "--memory"},
+                          {"--json", "--in-memory"});
+    if (const auto spec = args.value("--synthetic"))   // sparse-spheres never makes a dense array
+        if (const uint32_t n = parse_sparse_spheres(*spec)) return convert_sparse_spheres(args, n);
     const bool json = args.flag("--json");
-    const auto out = args.value("--output", "-o");
+    const auto out = args.value("--output");
     BuildOptions opt;
     if (const auto r = args.value("--iso-range")) opt.iso_range = cli::parse_range(*r, "--iso-range");
     if (const auto t = args.value("--tolerance")) {
@@ -306,7 +314,6 @@ int run(std::vector<std::string>& argv) {
     if (const auto m = args.value("--memory")) memory.budget = parse_memory(*m);
     memory.force_in_memory = args.flag("--in-memory");
     const ConvertSource src = parse_source(args);
-    args.finish();
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
     cli::check_output_file(*out, "-o");   // before the work, naming the user's path
 

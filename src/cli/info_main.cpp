@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "cli/common/json.h"
 #include "cli/common/output_path.h"
 #include "cli/common/report.h"
@@ -313,9 +314,17 @@ void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSi
 
 int main(int argc, char** argv) {
     return octiso::cli::run_main("octiso-info", argc, argv, [](std::vector<std::string>& argv_rest) {
-        cli::Args args(argv_rest);
+        for (const std::string& a : argv_rest)   // --help wins over every other argument
+            if (a == "--help" || a == "-h") {
+                std::cout << kUsage;
+                return 0;
+            }
+        if (argv_rest.empty()) {   // the same in every tool: the help, as a usage error
+            std::cerr << kUsage;
+            return 2;
+        }
+        const cli::Flags args(argv_rest, {"--extract-raw", "--extract", "--step", "--endian", "--bins"}, {"--json", "--verify"});
         const bool json = args.flag("--json");
-        const bool help = args.flag("--help") || args.flag("-h");
         const bool verify = args.flag("--verify");
         const std::optional<std::string> extract_raw_path = args.value("--extract-raw");
         const std::optional<std::string> extract_any_path = args.value("--extract");
@@ -326,15 +335,6 @@ int main(int argc, char** argv) {
         const std::optional<std::string> endian_text = args.value("--endian");
         const std::optional<std::string> bins_text = args.value("--bins");
         const std::vector<std::string> files = args.positional();
-        args.finish();
-        if (help) {
-            std::cout << kUsage;
-            return 0;
-        }
-        if (argv_rest.empty()) {   // the same in every tool: the help, as a usage error
-            std::cerr << kUsage;
-            return 2;
-        }
         if (files.size() != 1)
             throw Error("", std::string(files.empty() ? "no input file" : "more than one input file") + " (octiso-info --help lists every flag)");
         if ((step_text || endian_text) && !extract_path)
