@@ -11,6 +11,7 @@
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
 #include "cli/common/output_path.h"
+#include "cli/common/progress.h"
 #include "cli/common/report.h"
 #include "cli/render_camera.h"
 #include "octiso/antialias.h"
@@ -68,26 +69,6 @@ const char* kUsage =
     "  --isa auto|baseline|avx2  traversal kernel: auto = AVX2 where the CPU has it (default; same image)\n"
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
     "  --version, -h/--help\n";
-
-/// One line of progress with an ETA, redrawn in place; only when stderr is a terminal.
-class Progress {
-public:
-    explicit Progress(long long total) : total_(total), enabled_(total > 1 && ::isatty(2)), start_(std::chrono::steady_clock::now()) {}
-    void update(long long done) {
-        if (!enabled_) return;
-        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-        const double eta = done > 0 ? elapsed / double(done) * double(total_ - done) : 0.0;
-        const int width = 30, filled = int(width * done / total_);
-        std::fprintf(stderr, "\r[%.*s%*s] %lld/%lld  ETA %.1f s ", filled, "##############################", width - filled,
-                     "", done, total_, eta);
-        if (done == total_) std::fprintf(stderr, "\n");
-    }
-
-private:
-    long long total_;
-    bool enabled_;
-    std::chrono::steady_clock::time_point start_;
-};
 
 int run(std::vector<std::string>& argv) {
     cli::Args args(argv);
@@ -158,6 +139,10 @@ int run(std::vector<std::string>& argv) {
     // Everything about the outputs is checked before the first frame is rendered.
     const auto file = std::make_shared<const OctFile>(OctFile::open(inputs[0]));
     const OctInfo& info = file->info();
+    // CONVENTIONS 2b: --iso is given in real values; the tree and the renderer hold stored ones.
+    const std::vector<double> real_isovalues = options.isovalues;
+    for (double& v : options.isovalues) v = info.value_scale.stored(v);
+    trace_options.isovalues = options.isovalues;
     const std::vector<Camera> cameras = cli::cameras_for(camera_flags, info);
     const bool orbit = camera_flags.orbit.has_value();
     long long first = 0, last = 0;
@@ -215,8 +200,9 @@ int run(std::vector<std::string>& argv) {
     for (long long k = first; k <= last; ++k)
         if (const auto r = AnyOctree::step(file, uint32_t(k)).info().value_range)
             data_range = data_range ? std::array<double, 2>{std::min((*data_range)[0], (*r)[0]), std::max((*data_range)[1], (*r)[1])} : *r;
+    if (data_range) data_range = info.value_scale.real_range(*data_range);
     if (data_range)
-        for (const double v : options.isovalues)
+        for (const double v : real_isovalues)
             if (v < (*data_range)[0] || v > (*data_range)[1])
                 throw Error(inputs[0], "isovalue " + cli::number(v) + " lies outside the data range " + cli::number((*data_range)[0]) +
                                            " .. " + cli::number((*data_range)[1]) + (last > first ? " of the rendered steps" : "") +
@@ -241,7 +227,7 @@ int run(std::vector<std::string>& argv) {
     };
     if (json) {
         j.begin_object().field("file", inputs[0]).field("type", std::string(scalar_type_name(info.type)));
-        j.key("isovalues").array(options.isovalues);
+        j.key("isovalues").array(real_isovalues);
         j.field("width", cameras[0].width).field("height", cameras[0].height);
         j.field("root_finder", std::string(root_finder ? *root_finder : "neubauer")).field("embree", options.use_embree);
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
@@ -251,7 +237,7 @@ int run(std::vector<std::string>& argv) {
         camera_json(cameras[0]);
         j.key("frames").begin_array();
     }
-    Progress progress((long long)jobs.size());
+    cli::ProgressLine progress = cli::ProgressLine::on_stderr(jobs.size() > 1, 0.0);
     double total_seconds = 0;
     std::optional<Renderer> renderer;
     std::optional<AnyOctree> step_tree;
@@ -301,8 +287,9 @@ int run(std::vector<std::string>& argv) {
                          frame.stats.seconds, frame.stats.mrays_per_second(), (unsigned long long)frame.stats.hits,
                          frame.stats.threads, spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
                          orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
-        progress.update((long long)n + 1);
+        progress.update(double(n + 1), double(jobs.size()), std::to_string(n + 1) + "/" + std::to_string(jobs.size()) + " frames");
     }
+    progress.finish();
     if (json) {
         j.end_array().field("total_seconds", total_seconds).end_object();
         std::cout << "\n";
