@@ -1,0 +1,204 @@
+// Secondary rays and compositing (src/render/secondary.h, composite.h) against the dense exact
+// reference: shadow rays from the hits of a frame hit or miss where the reference says and at its
+// t; the layers along a composited ray are the reference's hits along the same ray, in order;
+// transmittance through nested spheres is the product of the crossed opacities; a convex surface
+// casts no shadow on its lit side (the start offset clears the root finder's error); the AO
+// sequence is reproducible and cosine-weighted.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "render/composite.h"
+#include "render/look_test_util.h"
+#include "render/render_test_util.h"
+#include "render/secondary.h"
+
+namespace octiso::test {
+namespace {
+
+/// Two concentric shells: f = 100 at the centre falling to 0 at radius 12 voxels, so iso 60 and 30
+/// are nested spheres (radius ~4.8 and ~8.4).
+DenseVolume<float> nested_spheres() {
+    const Dims dims{31, 31, 31};
+    DenseVolume<float> v{dims, std::vector<float>(dims.voxels())};
+    for (uint32_t z = 0; z < dims.z; ++z)
+        for (uint32_t y = 0; y < dims.y; ++y)
+            for (uint32_t x = 0; x < dims.x; ++x) {
+                const double r = std::hypot(double(x) - 15, double(y) - 15, double(z) - 15);
+                v.values[x + 31u * (y + 31u * z)] = float(std::max(0.0, 100.0 * (1 - r / 12)));
+            }
+    return v;
+}
+
+Vec3 unit(Vec3 d) { return vec_normalized(d); }
+
+TEST(ShadowRays, HitAndMissWhereTheReferenceSays) {
+    const auto v = make_field<uint8_t>(Field::Torus, {41, 37, 17});
+    Placement placement;
+    placement.spacing = {1.0, 1.0, 1.5};
+    const auto data = build_octree(v.view(), {});
+    RenderOptions options;
+    options.isovalues = {47.0, 90.0};
+    options.root_finder = RootFinder::exact;
+    const KernelTracer octree(data.view(), placement, options);
+    const ReferenceTracer<uint8_t> ref{v.view(), placement, options.isovalues};
+    const Camera cam = look_at({70, -40, 60}, {20, 18, 12}, {0, 0, 1}, 40, 48);
+    const PinholeCamera pinhole(cam);
+    const double offset = kSecondaryOffsetVoxels * 1.0;
+    int shadowed = 0, lit = 0;
+    for (const Vec3& light : {unit({-0.3, 0.8, 0.4}), unit({0.9, 0.1, 0.2}), unit({0.0, -0.0, 1.0})}) {
+        for (int py = 0; py < cam.height; ++py)
+            for (int px = 0; px < cam.width; ++px) {
+                const Ray primary = pinhole.ray(px, py);
+                const TraceHit h = octree(primary, true);
+                if (!h.is_hit()) continue;
+                const Ray s = shadow_ray(point_at(primary, h.t), light, offset, {});
+                const TraceHit a = octree(s, false), b = ref(s, false);
+                ASSERT_EQ(a.is_hit(), b.is_hit()) << "pixel " << px << "," << py;
+                if (a.is_hit()) {
+                    EXPECT_NEAR(a.t, b.t, 1e-3) << "pixel " << px << "," << py;
+                    EXPECT_EQ(a.iso_index, b.iso_index);
+                }
+                (a.is_hit() ? shadowed : lit)++;
+            }
+    }
+    EXPECT_GT(shadowed, 200) << "the torus shadows itself";
+    EXPECT_GT(lit, 200);
+}
+
+TEST(ShadowRays, AConvexSurfaceCastsNoShadowOnItsLitSide) {
+    const auto v = nested_spheres();
+    const auto data = build_octree(v.view(), {});
+    for (RootFinder finder : {RootFinder::neubauer, RootFinder::exact}) {
+        RenderOptions options;
+        options.isovalues = {30.0};
+        options.root_finder = finder;
+        const KernelTracer octree(data.view(), Placement{}, options);
+        const Camera cam = look_at({45, -35, 40}, {15, 15, 15}, {0, 0, 1}, 30, 64);
+        const PinholeCamera pinhole(cam);
+        const Vec3 light = unit({0.2, -0.9, 0.5});
+        int tested = 0;
+        for (int py = 0; py < cam.height; ++py)
+            for (int px = 0; px < cam.width; ++px) {
+                const Ray primary = pinhole.ray(px, py);
+                const TraceHit h = octree(primary, true);
+                // Well away from the terminator (n . l > 0.05): the trilinear sphere is convex at that scale.
+                if (!h.is_hit() || vec_dot(h.normal, light) < 0.05) continue;
+                ++tested;
+                const TraceHit s = octree(shadow_ray(point_at(primary, h.t), light, kSecondaryOffsetVoxels, {}), false);
+                EXPECT_FALSE(s.is_hit()) << "acne at pixel " << px << "," << py << " (t " << s.t << ")";
+            }
+        EXPECT_GT(tested, 500);
+    }
+}
+
+TEST(Layers, AreTheReferenceHitsAlongTheRayInOrder) {
+    const auto v = make_field<float>(Field::MarschnerLobb, {27, 27, 27});
+    const auto data = build_octree(v.view(), {});
+    RenderOptions options;
+    options.isovalues = {35.0, 70.0};
+    options.root_finder = RootFinder::exact;
+    const KernelTracer octree(data.view(), Placement{}, options);
+    const ReferenceTracer<float> ref{v.view(), Placement{}, options.isovalues};
+    const double alpha[] = {0.3, 0.6};
+    const Opacities opacity{alpha};
+    const Camera cam = look_at({50, -30, 45}, {13, 13, 13}, {0, 0, 1}, 40, 40);
+    const PinholeCamera pinhole(cam);
+    int multi = 0;
+    for (int py = 0; py < cam.height; ++py)
+        for (int px = 0; px < cam.width; ++px) {
+            Ray ray = pinhole.ray(px, py);
+            const ClipPlane cut[] = {{{0, 0, 1}, 20}};   // compositing honours the clip too
+            clip_ray(cut, ray);
+            Layers a, b;
+            SecondaryCounters ca, cb;
+            collect_layers(octree, ray, opacity, kSecondaryOffsetVoxels, a, ca);
+            collect_layers(ref, ray, opacity, kSecondaryOffsetVoxels, b, cb);
+            ASSERT_EQ(a.count, b.count) << "pixel " << px << "," << py;
+            for (int k = 0; k < a.count; ++k) {
+                EXPECT_NEAR(a.hit[k].t, b.hit[k].t, 1e-3) << "pixel " << px << "," << py << " layer " << k;
+                EXPECT_EQ(a.hit[k].iso_index, b.hit[k].iso_index);
+                if (k > 0) { EXPECT_GT(a.hit[k].t, a.hit[k - 1].t + kSecondaryOffsetVoxels * 0.999); }
+                EXPECT_LE(a.hit[k].t, ray.t_max);
+            }
+            EXPECT_EQ(ca.layer_rays, cb.layer_rays);
+            multi += a.count > 2;
+        }
+    EXPECT_GT(multi, 100) << "the view must see nested surfaces";
+}
+
+TEST(Layers, NestedSpheresComposeFrontToBack) {
+    const auto v = nested_spheres();
+    const auto data = build_octree(v.view(), {});
+    RenderOptions options;
+    options.isovalues = {30.0, 60.0};
+    options.root_finder = RootFinder::exact;
+    const KernelTracer octree(data.view(), Placement{}, options);
+    // Straight through the centre: outer in, inner in, inner out, outer out.
+    const Ray ray{{15.3, 15.2, -10}, unit({0.001, 0.0, 1.0})};
+    const double alpha[] = {0.5, 0.25};
+    Layers layers;
+    SecondaryCounters counters;
+    collect_layers(octree, ray, Opacities{alpha}, kSecondaryOffsetVoxels, layers, counters);
+    ASSERT_EQ(layers.count, 4);
+    const int order[] = {0, 1, 1, 0};
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(layers.hit[k].iso_index, order[k]) << "layer " << k;
+    EXPECT_EQ(counters.layer_rays, 4u) << "three continuations and the one that found nothing more";
+    const double pass = transmittance(octree, ray, Opacities{alpha}, kSecondaryOffsetVoxels, counters);
+    EXPECT_DOUBLE_EQ(pass, 0.5 * 0.75 * 0.75 * 0.5);
+    const double opaque[] = {1.0, 1.0};
+    EXPECT_EQ(transmittance(octree, ray, Opacities{opaque}, kSecondaryOffsetVoxels, counters), 0.0);
+    collect_layers(octree, ray, Opacities{opaque}, kSecondaryOffsetVoxels, layers, counters);
+    EXPECT_EQ(layers.count, 1) << "an opaque surface ends the list";
+    // The over operator: opaque layers give the first colour bit for bit.
+    const std::array<double, 3> colour[] = {{0.2, 0.4, 0.6}, {1, 1, 1}};
+    const double a1[] = {1.0, 1.0}, a2[] = {0.5, 1.0};
+    EXPECT_EQ(composite_over(colour, a1, 2, {0, 0, 0}), colour[0]);
+    const auto half = composite_over(colour, a2, 2, {0, 0, 0});
+    EXPECT_DOUBLE_EQ(half[0], 0.5 * 0.2 + 0.5 * 1.0);
+    const auto none = composite_over(colour, a2, 0, {0.1, 0.2, 0.3});
+    EXPECT_DOUBLE_EQ(none[2], 0.3);
+}
+
+TEST(AoSamples, ReproducibleStratifiedAndCosineWeighted) {
+    EXPECT_EQ(pixel_seed(3, 4, {0, 0}), pixel_seed(3, 4, {0, 0}));
+    EXPECT_NE(pixel_seed(3, 4, {0, 0}), pixel_seed(4, 3, {0, 0}));
+    EXPECT_NE(pixel_seed(3, 4, {0, 0}), pixel_seed(3, 4, {0.25, -0.1}));
+    EXPECT_EQ(reverse_bits(1u), 0x80000000u);
+    EXPECT_EQ(reverse_bits(6u), 0x60000000u);
+    const Vec3 n = unit({0.3, -0.5, 0.8});
+    double mean_cos = 0;
+    int count = 0;
+    for (int px = 0; px < 64; ++px) {
+        const uint32_t seed = pixel_seed(px, 7, {0, 0});
+        for (int s = 0; s < 16; ++s) {
+            const auto u = ao_sample(s, 16, seed);
+            ASSERT_GE(u[0], 0.0);
+            ASSERT_LT(u[0], 1.0);
+            ASSERT_GE(u[1], 0.0);
+            ASSERT_LT(u[1], 1.0);
+            const Ray r = ao_ray({1, 2, 3}, n, u, 0.5, 4.0, {});
+            EXPECT_NEAR(vec_dot(r.dir, r.dir), 1.0, 1e-12);
+            const double c = vec_dot(r.dir, n);
+            EXPECT_GE(c, 0.0) << "inside the hemisphere of the normal";
+            mean_cos += c, ++count;
+            EXPECT_EQ(r.t_min, 0.5);
+            EXPECT_EQ(r.t_max, 4.0);
+        }
+    }
+    // Cosine-weighted: E[cos] = 2/3 (uniform would give 1/2).
+    EXPECT_NEAR(mean_cos / count, 2.0 / 3.0, 0.01);
+    // The basis is orthonormal, also at the poles.
+    for (const Vec3& m : {Vec3{0, 0, 1}, Vec3{0, 0, -1}, unit({1, 2, -3})}) {
+        Vec3 t, b;
+        orthonormal_basis(m, t, b);
+        EXPECT_NEAR(vec_dot(t, b), 0, 1e-12);
+        EXPECT_NEAR(vec_dot(t, m), 0, 1e-12);
+        EXPECT_NEAR(vec_dot(b, m), 0, 1e-12);
+        EXPECT_NEAR(vec_dot(t, t), 1, 1e-12);
+    }
+}
+
+}  // namespace
+}  // namespace octiso::test
