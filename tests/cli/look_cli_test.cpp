@@ -57,6 +57,14 @@ TEST_F(LookCli, EachEffectChangesColourNotDepthAndReportsItsRays) {
     EXPECT_EQ(json_number(render("--ao 4", "ao4").out, "ao_rays"), 4 * hits);
 }
 
+TEST_F(LookCli, AnImageIsTheSameOnEveryRunAndThreadCount) {
+    const std::string flags = "--shadows --ao 6 --opacity 0.5 --spp 2 ";
+    const ToolRun a = render(flags, "a"), b = render(flags + "--threads 1", "b");
+    ASSERT_EQ(a.status, 0) << a.err;
+    ASSERT_EQ(b.status, 0) << b.err;
+    EXPECT_EQ(image("a.png").pixels, image("b.png").pixels);
+}
+
 TEST_F(LookCli, ClipCutsTheDepthAtThePlane) {
     // The data box is [0, 24]^3; keep z <= 12 with an eye above the data: every hit lies at or below z = 12.
     const std::string cam = "--eye 12,12,60 --look 12,12,0 --up 0,1,0 --fov 30 ";
