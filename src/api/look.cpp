@@ -143,6 +143,11 @@ LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame&
                         const uint32_t seed = n_ao > 0 ? pixel_seed(px, py, camera.pixel_offset) : 0;
                         for (int k = 0; k < layers.count; ++k) {
                             const TraceHit& h = layers.hit[k];
+                            alpha[k] = composite ? opacity.of(h.iso_index) : 1.0;
+                            if (alpha[k] == 0) {   // invisible (--opacity 0): no secondary rays for it
+                                colour[k] = {0, 0, 0};
+                                continue;
+                            }
                             const Vec3 p = point_at(ray, h.t);
                             KitVisibility visible;
                             if (m.look.shadows && vec_dot(h.normal, to_light[kKeyLight]) > 0) {
@@ -165,7 +170,6 @@ LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame&
                                 const double lambert = std::fabs(vec_dot(h.normal, ray.dir));
                                 for (int a = 0; a < 3; ++a) colour[k][size_t(a)] = albedo[a] * (kAmbient + (1.0f - kAmbient) * lambert);
                             }
-                            alpha[k] = composite ? opacity.of(h.iso_index) : 1.0;
                         }
                         // 3. Front to back over the background.
                         const std::array<double, 3> rgb = composite ? composite_over(colour, alpha, layers.count, background) : colour[0];

@@ -1,5 +1,7 @@
 #include "cli/render_look.h"
 
+#include <cstdio>
+
 #include "octiso/error.h"
 
 namespace octiso::cli {
@@ -35,6 +37,26 @@ LookFlags LookFlags::take(Args& args) {
         f.clip_planes.push_back({{v[0], v[1], v[2]}, v[3]});
     }
     return f;
+}
+
+void write_look_json(JsonWriter& j, const Look& look, const std::vector<ClipPlane>& clip_planes) {
+    if (!look.active() && clip_planes.empty()) return;
+    j.key("look").begin_object().field("shadows", look.shadows).field("ao", look.ao_samples);
+    j.field("ao_distance_voxels", look.ao_distance_voxels).key("opacity").array(look.opacity);
+    j.key("clip").begin_array();
+    for (const ClipPlane& c : clip_planes) j.array(std::array<double, 4>{c.normal[0], c.normal[1], c.normal[2], c.d});
+    j.end_array().end_object();
+}
+
+void write_look_stats_json(JsonWriter& j, const LookStats& stats) {
+    j.key("secondary").begin_object().field("seconds", stats.seconds).field("shadow_rays", stats.shadow_rays);
+    j.field("ao_rays", stats.ao_rays).field("layer_rays", stats.layer_rays).end_object();
+}
+
+void print_look_stats(const LookStats& s) {
+    std::fprintf(stderr, "  look: %.3f s for %llu secondary rays (%llu shadow, %llu ambient occlusion, %llu past translucent surfaces)\n",
+                 s.seconds, (unsigned long long)s.secondary_rays(), (unsigned long long)s.shadow_rays, (unsigned long long)s.ao_rays,
+                 (unsigned long long)s.layer_rays);
 }
 
 }  // namespace octiso::cli

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/common/cli.h"
+#include "cli/common/json.h"
 #include "octiso/look.h"
 #include "octiso/render.h"
 
@@ -21,5 +22,11 @@ struct LookFlags {
 
 /// The help text of these flags (one block of octiso-render --help).
 extern const char* const kLookUsage;
+
+/// The run's look as "look": {...} in the run's --json object (only when a flag is given).
+void write_look_json(JsonWriter& j, const Look& look, const std::vector<ClipPlane>& clip_planes);
+/// One frame's look cost: "secondary": {...} in its --json object, or the text report's line.
+void write_look_stats_json(JsonWriter& j, const LookStats& stats);
+void print_look_stats(const LookStats& stats);
 
 }  // namespace octiso::cli

@@ -254,13 +254,7 @@ int run(std::vector<std::string>& argv) {
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
-        if (look.active() || !options.clip_planes.empty()) {   // issue 17 item 7
-            j.key("look").begin_object().field("shadows", look.shadows).field("ao", look.ao_samples);
-            j.field("ao_distance_voxels", look.ao_distance_voxels).key("opacity").array(look.opacity);
-            j.key("clip").begin_array();
-            for (const ClipPlane& c : options.clip_planes) j.array(std::array<double, 4>{c.normal[0], c.normal[1], c.normal[2], c.d});
-            j.end_array().end_object();
-        }
+        cli::write_look_json(j, look, options.clip_planes);   // issue 17 item 7
         j.key("camera");
         camera_json(cameras[0]);
         j.key("frames").begin_array();
@@ -308,10 +302,7 @@ int run(std::vector<std::string>& argv) {
             j.field("mrays_per_second", frame.stats.mrays_per_second()).field("rays", frame.stats.rays);
             j.field("hits", frame.stats.hits).field("threads", frame.stats.threads);
             if (out_path) j.field("image", name_for(out_path, "-o", job.index));
-            if (look_shader) {
-                j.key("secondary").begin_object().field("seconds", look_stats.seconds).field("shadow_rays", look_stats.shadow_rays);
-                j.field("ao_rays", look_stats.ao_rays).field("layer_rays", look_stats.layer_rays).end_object();
-            }
+            if (look_shader) cli::write_look_stats_json(j, look_stats);
             j.key("camera");
             camera_json(*job.camera);
             j.end_object();
@@ -323,10 +314,7 @@ int run(std::vector<std::string>& argv) {
                          frame.stats.seconds, frame.stats.mrays_per_second(), (unsigned long long)frame.stats.hits,
                          frame.stats.threads, spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
                          orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
-        if (look_shader && (!series || !::isatty(2)))
-            std::fprintf(stderr, "  look: %.3f s for %llu secondary rays (%llu shadow, %llu ambient occlusion, %llu past translucent surfaces)\n",
-                         look_stats.seconds, (unsigned long long)look_stats.secondary_rays(), (unsigned long long)look_stats.shadow_rays,
-                         (unsigned long long)look_stats.ao_rays, (unsigned long long)look_stats.layer_rays);
+        if (look_shader && (!series || !::isatty(2))) cli::print_look_stats(look_stats);
         progress.update((long long)n + 1);
     }
     if (json) {

@@ -67,6 +67,42 @@ TEST(ShadowRays, HitAndMissWhereTheReferenceSays) {
     EXPECT_GT(lit, 200);
 }
 
+TEST(AoRays, HitAndMissWhereTheReferenceSays) {
+    const auto v = make_field<int16_t>(Field::Sierpinski, {27, 27, 27});
+    Placement placement;
+    placement.spacing = {0.5, 0.5, 0.7};
+    const auto data = build_octree(v.view(), {});
+    RenderOptions options;
+    options.isovalues = {60.0};
+    options.root_finder = RootFinder::exact;
+    const KernelTracer octree(data.view(), placement, options);
+    const ReferenceTracer<int16_t> ref{v.view(), placement, options.isovalues};
+    const Camera cam = look_at({30, -20, 25}, {6.5, 6.5, 9}, {0, 0, 1}, 40, 32);
+    const PinholeCamera pinhole(cam);
+    const double voxel = 0.5, reach = kDefaultAoDistanceVoxels * voxel;
+    const ClipPlane cut[] = {{{0, 0, 1}, 15}};
+    int occluded = 0, open = 0;
+    for (int py = 0; py < cam.height; ++py)
+        for (int px = 0; px < cam.width; ++px) {
+            const Ray primary = pinhole.ray(px, py);
+            const TraceHit h = octree(primary, true);
+            if (!h.is_hit()) continue;
+            const uint32_t seed = pixel_seed(px, py, {0, 0});
+            for (int s = 0; s < 8; ++s) {
+                const Ray r = ao_ray(point_at(primary, h.t), h.normal, ao_sample(s, 8, seed), kSecondaryOffsetVoxels * voxel, reach, cut);
+                const TraceHit a = octree(r, false), b = ref(r, false);
+                ASSERT_EQ(a.is_hit(), b.is_hit()) << "pixel " << px << "," << py << " sample " << s;
+                if (a.is_hit()) {
+                    EXPECT_NEAR(a.t, b.t, 1e-3 * voxel);
+                    EXPECT_LE(a.t, reach);
+                }
+                (a.is_hit() ? occluded : open)++;
+            }
+        }
+    EXPECT_GT(occluded, 300) << "the sponge's holes occlude";
+    EXPECT_GT(open, 300);
+}
+
 TEST(ShadowRays, AConvexSurfaceCastsNoShadowOnItsLitSide) {
     const auto v = nested_spheres();
     const auto data = build_octree(v.view(), {});
