@@ -2,8 +2,9 @@
 // several composited by opacity), per surface the key light's shadow ray and the AO rays, the
 // light kit shaded with what they let through, and the layers composited over the background.
 // The secondary rays go through a TracerKernel of the frame's own options (same scalar type,
-// root finder, instruction set), called directly, one ray at a time: shadow rays of a block of
-// pixels are coherent enough for packets, AO rays are not (left for later, BENCHMARKS.md).
+// root finder, instruction set, traversal), called directly: the shadow rays of a 4x2 block of
+// pixels as one packet (bit-identical to single rays; 2-3 % off the shadow pass on ch2better,
+// BENCHMARKS.md, "Ray-traced look"), AO rays and continuations one by one (they scatter).
 #include "octiso/look.h"
 
 #include <algorithm>
@@ -74,6 +75,23 @@ LookShader::~LookShader() = default;
 LookShader::LookShader(LookShader&&) noexcept = default;
 LookShader& LookShader::operator=(LookShader&&) noexcept = default;
 
+namespace {
+
+/// Pixels are shaded in blocks of 4x2, the primary rays' packet shape (renderer.cpp), so that the
+/// block's shadow rays go to the kernel as one packet.
+constexpr int kBlockW = 4, kBlockH = 2, kBlock = kBlockW * kBlockH;
+
+/// One pixel of a block between its passes: its ray, its surfaces and their key light.
+struct BlockPixel {
+    int px = 0, py = 0;
+    size_t i = 0;
+    Ray ray;
+    Layers layers;
+    double key[kMaxLayers];   ///< transmittance of the key light's shadow ray per layer (1: lit)
+};
+
+}  // namespace
+
 LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame& frame) const {
     const Impl& m = *impl_;
     const size_t pixels = size_t(frame.width) * size_t(frame.height);
@@ -97,6 +115,7 @@ LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame&
     const std::array<double, 3> background{shading.background[0], shading.background[1], shading.background[2]};
     const TracerKernel& kernel = m.kernel;
     const auto trace = [&](const Ray& r, bool normal) { return kernel.trace(kernel.user, r, normal); };
+    const bool packets = m.options.traversal == Traversal::packets;
     std::atomic<uint64_t> shadow_rays{0}, ao_rays{0}, layer_rays{0};
 
     const auto t0 = std::chrono::steady_clock::now();
@@ -107,74 +126,110 @@ LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame&
             const TileGrid grid = tile_grid_for(camera.width, camera.height, m.options.tile_size);
             for_each_tile(grid, {}, true, [&](const PixelRect& rect, TileCounters& tile) {
                 SecondaryCounters local;
-                Layers layers;
+                BlockPixel block[kBlock];
                 std::array<double, 3> colour[kMaxLayers];
                 double alpha[kMaxLayers];
-                for (int py = rect.y0; py < rect.y1; ++py)
-                    for (int px = rect.x0; px < rect.x1; ++px) {
-                        const size_t i = size_t(py) * size_t(frame.width) + size_t(px);
-                        uint8_t* out = &frame.rgb[3 * i];
-                        Ray ray = pinhole.ray(px, py);
-                        clip_ray(planes, ray);
-                        // 1. The surfaces: the frame's own hit, or the composited list (whose
-                        //    first entry is that same hit: the same kernel on the same ray).
-                        if (composite) {
-                            if (std::isfinite(frame.depth[i])) collect_layers(trace, ray, opacity, offset, layers, local);
-                            else layers.count = 0;
-                        } else if (std::isfinite(frame.depth[i])) {
-                            // The AOV's float t lies within t * 2^-24 of the traced double: for
-                            // any camera within 10^4 voxels of the data, far inside the 0.02-voxel
-                            // start offset of the secondary rays, so re-tracing it would buy nothing.
-                            TraceHit& h = layers.hit[0];
-                            h.t = double(frame.depth[i]);
-                            h.normal = {frame.normal[3 * i], frame.normal[3 * i + 1], frame.normal[3 * i + 2]};
-                            h.iso_index = m.options.isovalues.size() > 1
-                                              ? nearest_isovalue(field_at(octree, m.tree.placement(), point_at(ray, h.t)), m.options.isovalues)
-                                              : 0;
-                            layers.count = 1;
-                        } else {
-                            layers.count = 0;
+                for (int y0 = rect.y0; y0 < rect.y1; y0 += kBlockH)
+                    for (int x0 = rect.x0; x0 < rect.x1; x0 += kBlockW) {
+                        // 1. The surfaces of each pixel of the block: the frame's own hit, or the
+                        //    composited list (whose first entry is that same hit: the same kernel
+                        //    on the same ray).
+                        int n = 0;
+                        for (int py = y0; py < std::min(y0 + kBlockH, rect.y1); ++py)
+                            for (int px = x0; px < std::min(x0 + kBlockW, rect.x1); ++px) {
+                                BlockPixel& b = block[n++];
+                                b.px = px, b.py = py, b.i = size_t(py) * size_t(frame.width) + size_t(px);
+                                b.ray = pinhole.ray(px, py);
+                                clip_ray(planes, b.ray);
+                                Layers& layers = b.layers;
+                                const size_t i = b.i;
+                                if (!std::isfinite(frame.depth[i])) {
+                                    layers.count = 0;
+                                } else if (composite) {
+                                    collect_layers(trace, b.ray, opacity, offset, layers, local);
+                                } else {
+                                    // The AOV's float t lies within t * 2^-24 of the traced double:
+                                    // for any camera within 10^4 voxels of the data, far inside the
+                                    // 0.02-voxel start offset of the secondary rays, so re-tracing
+                                    // it would buy nothing.
+                                    TraceHit& h = layers.hit[0];
+                                    h.t = double(frame.depth[i]);
+                                    h.normal = {frame.normal[3 * i], frame.normal[3 * i + 1], frame.normal[3 * i + 2]};
+                                    h.iso_index = m.options.isovalues.size() > 1
+                                                      ? nearest_isovalue(field_at(octree, m.tree.placement(), point_at(b.ray, h.t)),
+                                                                         m.options.isovalues)
+                                                      : 0;
+                                    layers.count = 1;
+                                }
+                                for (int k = 0; k < layers.count; ++k) b.key[k] = 1.0;
+                            }
+                        // 2. The key light's shadow rays of the whole block, in packets of up to
+                        //    8: they share one direction and start close together, like primary rays.
+                        if (m.look.shadows) {
+                            Ray rays[kBlock];
+                            int owner[kBlock][2];
+                            int queued = 0;
+                            const auto flush = [&] {
+                                TraceHit first[kBlock];
+                                if (packets) kernel.trace_packet(kernel.user, rays, queued, nullptr, false, first);
+                                else for (int q = 0; q < queued; ++q) first[q] = trace(rays[q], false);
+                                for (int q = 0; q < queued; ++q)
+                                    block[owner[q][0]].key[owner[q][1]] = transmittance(trace, rays[q], opacity, offset, local, &first[q]);
+                                queued = 0;
+                            };
+                            for (int j = 0; j < n; ++j)
+                                for (int k = 0; k < block[j].layers.count; ++k) {
+                                    const TraceHit& h = block[j].layers.hit[k];
+                                    if ((composite && opacity.of(h.iso_index) == 0) || !(vec_dot(h.normal, to_light[kKeyLight]) > 0)) continue;
+                                    ++local.shadow_rays;
+                                    rays[queued] = shadow_ray(point_at(block[j].ray, h.t), to_light[kKeyLight], offset, planes);
+                                    owner[queued][0] = j, owner[queued][1] = k;
+                                    if (++queued == kBlock) flush();
+                                }
+                            if (queued) flush();
                         }
-                        if (layers.count == 0) {
-                            for (int a = 0; a < 3; ++a) out[a] = to_srgb8(shading.background[size_t(a)]);
-                            continue;
-                        }
-                        // 2. Per surface, what reaches it of the key light and of the sky, and its colour.
-                        const uint32_t seed = n_ao > 0 ? pixel_seed(px, py, camera.pixel_offset) : 0;
-                        for (int k = 0; k < layers.count; ++k) {
-                            const TraceHit& h = layers.hit[k];
-                            alpha[k] = composite ? opacity.of(h.iso_index) : 1.0;
-                            if (alpha[k] == 0) {   // invisible (--opacity 0): no secondary rays for it
-                                colour[k] = {0, 0, 0};
+                        // 3. Per surface, what reaches it of the sky, and its colour; front to back
+                        //    over the background.
+                        for (int j = 0; j < n; ++j) {
+                            const BlockPixel& b = block[j];
+                            const Layers& layers = b.layers;
+                            uint8_t* out = &frame.rgb[3 * b.i];
+                            if (layers.count == 0) {
+                                for (int a = 0; a < 3; ++a) out[a] = to_srgb8(shading.background[size_t(a)]);
                                 continue;
                             }
-                            const Vec3 p = point_at(ray, h.t);
-                            KitVisibility visible;
-                            if (m.look.shadows && vec_dot(h.normal, to_light[kKeyLight]) > 0) {
-                                ++local.shadow_rays;
-                                visible.key = transmittance(trace, shadow_ray(p, to_light[kKeyLight], offset, planes), opacity, offset, local);
+                            const uint32_t seed = n_ao > 0 ? pixel_seed(b.px, b.py, camera.pixel_offset) : 0;
+                            for (int k = 0; k < layers.count; ++k) {
+                                const TraceHit& h = layers.hit[k];
+                                alpha[k] = composite ? opacity.of(h.iso_index) : 1.0;
+                                if (alpha[k] == 0) {   // invisible (--opacity 0): no secondary rays for it
+                                    colour[k] = {0, 0, 0};
+                                    continue;
+                                }
+                                KitVisibility visible;
+                                visible.key = b.key[k];
+                                if (n_ao > 0) {
+                                    const Vec3 p = point_at(b.ray, h.t);
+                                    const uint32_t layer_seed = hash32(seed + uint32_t(k));
+                                    double open = 0;
+                                    for (int s = 0; s < n_ao; ++s)
+                                        open += transmittance(trace, ao_ray(p, h.normal, ao_sample(s, n_ao, layer_seed), offset, reach, planes),
+                                                              opacity, offset, local);
+                                    local.ao_rays += uint64_t(n_ao);
+                                    visible.ambient = open / double(n_ao);
+                                }
+                                const float* albedo = albedo_of(shading, h.iso_index);
+                                if (is_kit) {
+                                    colour[k] = shade_light_kit(kit, to_light, h.normal, b.ray.dir, albedo, visible);
+                                } else {   // the headlight formula of shade_frame
+                                    const double lambert = std::fabs(vec_dot(h.normal, b.ray.dir));
+                                    for (int a = 0; a < 3; ++a) colour[k][size_t(a)] = albedo[a] * (kAmbient + (1.0f - kAmbient) * lambert);
+                                }
                             }
-                            if (n_ao > 0) {
-                                const uint32_t layer_seed = hash32(seed + uint32_t(k));
-                                double open = 0;
-                                for (int s = 0; s < n_ao; ++s)
-                                    open += transmittance(trace, ao_ray(p, h.normal, ao_sample(s, n_ao, layer_seed), offset, reach, planes),
-                                                          opacity, offset, local);
-                                local.ao_rays += uint64_t(n_ao);
-                                visible.ambient = open / double(n_ao);
-                            }
-                            const float* albedo = albedo_of(shading, h.iso_index);
-                            if (is_kit) {
-                                colour[k] = shade_light_kit(kit, to_light, h.normal, ray.dir, albedo, visible);
-                            } else {   // the headlight formula of shade_frame
-                                const double lambert = std::fabs(vec_dot(h.normal, ray.dir));
-                                for (int a = 0; a < 3; ++a) colour[k][size_t(a)] = albedo[a] * (kAmbient + (1.0f - kAmbient) * lambert);
-                            }
+                            const std::array<double, 3> rgb = composite ? composite_over(colour, alpha, layers.count, background) : colour[0];
+                            for (int a = 0; a < 3; ++a) out[a] = to_srgb8(float(rgb[size_t(a)]));
+                            ++tile.hits;
                         }
-                        // 3. Front to back over the background.
-                        const std::array<double, 3> rgb = composite ? composite_over(colour, alpha, layers.count, background) : colour[0];
-                        for (int a = 0; a < 3; ++a) out[a] = to_srgb8(float(rgb[size_t(a)]));
-                        ++tile.hits;
                     }
                 shadow_rays += local.shadow_rays, ao_rays += local.ao_rays, layer_rays += local.layer_rays;
             });

@@ -62,13 +62,15 @@ inline Vec3 point_at(const Ray& ray, double t) {
 
 /// The fraction of light that passes `ray` on its interval: 1 on a miss, the product of
 /// (1 - opacity) over the surfaces it crosses, each next one searched from offset past the last
-/// (0 at the first opaque one). Adds the continuations to counters.layer_rays.
+/// (0 at the first opaque one). Adds the continuations to counters.layer_rays. `first`, if given,
+/// is the ray's first hit already traced (in a packet), and is not traced again.
 template <class Trace>
-double transmittance(Trace&& trace, Ray ray, const Opacities& opacity, double offset, SecondaryCounters& counters) {
+double transmittance(Trace&& trace, Ray ray, const Opacities& opacity, double offset, SecondaryCounters& counters,
+                     const TraceHit* first = nullptr) {
     double pass = 1.0;
     for (int layer = 0; layer < kMaxLayers; ++layer) {
         if (layer > 0) ++counters.layer_rays;
-        const TraceHit hit = trace(ray, false);
+        const TraceHit hit = layer == 0 && first ? *first : trace(ray, false);
         if (!hit.is_hit()) return pass;
         pass *= 1.0 - opacity.of(hit.iso_index);
         if (pass <= 1.0 - kOpaqueAlpha) return 0.0;

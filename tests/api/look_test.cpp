@@ -95,6 +95,9 @@ TEST_F(LookTest, TheSameImageOnEveryRunAndThreadCount) {
                 c = shade(look, ShadingModel::kit, nullptr, 2);
     EXPECT_EQ(a.rgb, b.rgb);
     EXPECT_EQ(a.rgb, c.rgb);
+    // Shadow rays in packets (the default) or one by one: the same image.
+    options_.traversal = Traversal::single;
+    EXPECT_EQ(shade(look).rgb, a.rgb);
 }
 
 constexpr std::array<float, 3> kAlbedoOfInner{0.3f, 0.6f, 0.9f};
