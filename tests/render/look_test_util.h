@@ -3,11 +3,14 @@
 // so every secondary ray can be traced by both and compared.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "math/hit.h"
 #include "math/ray.h"
 #include "octiso/build.h"
+#include "octree/octree_test_util.h"
 #include "reference/brute_force.h"
 #include "render/clip.h"
 #include "render/pinhole_camera.h"
@@ -53,6 +56,20 @@ Frame reference_frame_clipped(const ReferenceTracer<T>& ref, const Camera& camer
             f.depth[size_t(py) * size_t(f.width) + size_t(px)] = float(ref(ray, false).t);
         }
     return f;
+}
+
+/// Two concentric shells: f = 100 at the centre falling to 0 at radius 12 voxels, so iso 60 and 30
+/// are nested spheres (radius ~4.8 and ~8.4).
+inline DenseVolume<float> nested_spheres() {
+    const Dims dims{31, 31, 31};
+    DenseVolume<float> v{dims, std::vector<float>(dims.voxels())};
+    for (uint32_t z = 0; z < dims.z; ++z)
+        for (uint32_t y = 0; y < dims.y; ++y)
+            for (uint32_t x = 0; x < dims.x; ++x) {
+                const double r = std::hypot(double(x) - 15, double(y) - 15, double(z) - 15);
+                v.values[x + 31u * (y + 31u * z)] = float(std::max(0.0, 100.0 * (1 - r / 12)));
+            }
+    return v;
 }
 
 }  // namespace octiso::test

@@ -1,35 +1,18 @@
-// Secondary rays and compositing (src/render/secondary.h, composite.h) against the dense exact
-// reference: shadow rays from the hits of a frame hit or miss where the reference says and at its
-// t; the layers along a composited ray are the reference's hits along the same ray, in order;
-// transmittance through nested spheres is the product of the crossed opacities; a convex surface
+// Secondary rays (src/render/secondary.h) against the dense exact reference: shadow and AO rays
+// from the hits of a frame hit or miss where the reference says and at its t; a convex surface
 // casts no shadow on its lit side (the start offset clears the root finder's error); the AO
-// sequence is reproducible and cosine-weighted.
+// sequence is reproducible and cosine-weighted. Compositing is tests/render/composite_test.cpp.
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "render/composite.h"
 #include "render/look_test_util.h"
 #include "render/render_test_util.h"
 #include "render/secondary.h"
 
 namespace octiso::test {
 namespace {
-
-/// Two concentric shells: f = 100 at the centre falling to 0 at radius 12 voxels, so iso 60 and 30
-/// are nested spheres (radius ~4.8 and ~8.4).
-DenseVolume<float> nested_spheres() {
-    const Dims dims{31, 31, 31};
-    DenseVolume<float> v{dims, std::vector<float>(dims.voxels())};
-    for (uint32_t z = 0; z < dims.z; ++z)
-        for (uint32_t y = 0; y < dims.y; ++y)
-            for (uint32_t x = 0; x < dims.x; ++x) {
-                const double r = std::hypot(double(x) - 15, double(y) - 15, double(z) - 15);
-                v.values[x + 31u * (y + 31u * z)] = float(std::max(0.0, 100.0 * (1 - r / 12)));
-            }
-    return v;
-}
 
 Vec3 unit(Vec3 d) { return vec_normalized(d); }
 
@@ -127,74 +110,6 @@ TEST(ShadowRays, AConvexSurfaceCastsNoShadowOnItsLitSide) {
             }
         EXPECT_GT(tested, 500);
     }
-}
-
-TEST(Layers, AreTheReferenceHitsAlongTheRayInOrder) {
-    const auto v = make_field<float>(Field::MarschnerLobb, {27, 27, 27});
-    const auto data = build_octree(v.view(), {});
-    RenderOptions options;
-    options.isovalues = {35.0, 70.0};
-    options.root_finder = RootFinder::exact;
-    const KernelTracer octree(data.view(), Placement{}, options);
-    const ReferenceTracer<float> ref{v.view(), Placement{}, options.isovalues};
-    const double alpha[] = {0.3, 0.6};
-    const Opacities opacity{alpha};
-    const Camera cam = look_at({50, -30, 45}, {13, 13, 13}, {0, 0, 1}, 40, 40);
-    const PinholeCamera pinhole(cam);
-    int multi = 0;
-    for (int py = 0; py < cam.height; ++py)
-        for (int px = 0; px < cam.width; ++px) {
-            Ray ray = pinhole.ray(px, py);
-            const ClipPlane cut[] = {{{0, 0, 1}, 20}};   // compositing honours the clip too
-            clip_ray(cut, ray);
-            Layers a, b;
-            SecondaryCounters ca, cb;
-            collect_layers(octree, ray, opacity, kSecondaryOffsetVoxels, a, ca);
-            collect_layers(ref, ray, opacity, kSecondaryOffsetVoxels, b, cb);
-            ASSERT_EQ(a.count, b.count) << "pixel " << px << "," << py;
-            for (int k = 0; k < a.count; ++k) {
-                EXPECT_NEAR(a.hit[k].t, b.hit[k].t, 1e-3) << "pixel " << px << "," << py << " layer " << k;
-                EXPECT_EQ(a.hit[k].iso_index, b.hit[k].iso_index);
-                if (k > 0) { EXPECT_GT(a.hit[k].t, a.hit[k - 1].t + kSecondaryOffsetVoxels * 0.999); }
-                EXPECT_LE(a.hit[k].t, ray.t_max);
-            }
-            EXPECT_EQ(ca.layer_rays, cb.layer_rays);
-            multi += a.count > 2;
-        }
-    EXPECT_GT(multi, 100) << "the view must see nested surfaces";
-}
-
-TEST(Layers, NestedSpheresComposeFrontToBack) {
-    const auto v = nested_spheres();
-    const auto data = build_octree(v.view(), {});
-    RenderOptions options;
-    options.isovalues = {30.0, 60.0};
-    options.root_finder = RootFinder::exact;
-    const KernelTracer octree(data.view(), Placement{}, options);
-    // Straight through the centre: outer in, inner in, inner out, outer out.
-    const Ray ray{{15.3, 15.2, -10}, unit({0.001, 0.0, 1.0})};
-    const double alpha[] = {0.5, 0.25};
-    Layers layers;
-    SecondaryCounters counters;
-    collect_layers(octree, ray, Opacities{alpha}, kSecondaryOffsetVoxels, layers, counters);
-    ASSERT_EQ(layers.count, 4);
-    const int order[] = {0, 1, 1, 0};
-    for (int k = 0; k < 4; ++k) EXPECT_EQ(layers.hit[k].iso_index, order[k]) << "layer " << k;
-    EXPECT_EQ(counters.layer_rays, 4u) << "three continuations and the one that found nothing more";
-    const double pass = transmittance(octree, ray, Opacities{alpha}, kSecondaryOffsetVoxels, counters);
-    EXPECT_DOUBLE_EQ(pass, 0.5 * 0.75 * 0.75 * 0.5);
-    const double opaque[] = {1.0, 1.0};
-    EXPECT_EQ(transmittance(octree, ray, Opacities{opaque}, kSecondaryOffsetVoxels, counters), 0.0);
-    collect_layers(octree, ray, Opacities{opaque}, kSecondaryOffsetVoxels, layers, counters);
-    EXPECT_EQ(layers.count, 1) << "an opaque surface ends the list";
-    // The over operator: opaque layers give the first colour bit for bit.
-    const std::array<double, 3> colour[] = {{0.2, 0.4, 0.6}, {1, 1, 1}};
-    const double a1[] = {1.0, 1.0}, a2[] = {0.5, 1.0};
-    EXPECT_EQ(composite_over(colour, a1, 2, {0, 0, 0}), colour[0]);
-    const auto half = composite_over(colour, a2, 2, {0, 0, 0});
-    EXPECT_DOUBLE_EQ(half[0], 0.5 * 0.2 + 0.5 * 1.0);
-    const auto none = composite_over(colour, a2, 0, {0.1, 0.2, 0.3});
-    EXPECT_DOUBLE_EQ(none[2], 0.3);
 }
 
 TEST(AoSamples, ReproducibleStratifiedAndCosineWeighted) {
