@@ -1,12 +1,12 @@
 #!/usr/bin/python3
 """The frame-time cost of each ray-traced look flag of octiso-render (issue 17 item 7): one FILE.oct,
-one camera, each row rendered REPEAT times (the median kept), printed as the markdown table of
-BENCHMARKS.md ("Ray-traced look").
+one camera, each row rendered REPEAT times on THREADS threads, the fastest run kept (the least
+disturbed by other work on a shared machine), printed as the markdown table of BENCHMARKS.md
+("Ray-traced look").
 
-    scripts/look_cost.py [--render build/octiso-render] [--size 512x512] [--repeat 3] FILE.oct"""
+    scripts/look_cost.py [--render build/octiso-render] [--size 512x512] [--repeat 5] [--threads 1] FILE.oct"""
 import argparse
 import json
-import statistics
 import subprocess
 import tempfile
 
@@ -28,22 +28,23 @@ def main():
     p.add_argument("file")
     p.add_argument("--render", default="build/octiso-render")
     p.add_argument("--size", default="512x512")
-    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--repeat", type=int, default=5)
+    p.add_argument("--threads", type=int, default=1)
     a = p.parse_args()
-    print(f"| flags ({a.file}, {a.size}) | tile loop s | look s | whole frame s | x light kit | secondary rays | shadow | AO | past translucent | look Mrays/s |")
+    print(f"| flags ({a.file}, {a.size}, {a.threads} thread(s), best of {a.repeat}) | tile loop s | look s | whole frame s | x light kit | secondary rays | shadow | AO | past translucent | look Mrays/s |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     base = None
     with tempfile.TemporaryDirectory() as tmp:
         for name, flags in ROWS:
             runs = []
             for _ in range(a.repeat):
-                out = subprocess.run([a.render, a.file, *flags.split(), "--size", a.size, "-o", tmp + "/x.png", "--json"],
+                out = subprocess.run([a.render, a.file, *flags.split(), "--size", a.size, "--threads", str(a.threads), "-o", tmp + "/x.png", "--json"],
                                      check=True, capture_output=True, text=True).stdout
                 runs.append(json.loads(out)["frames"][0])
-            frame = statistics.median(r["frame_seconds"] for r in runs)
-            tile = statistics.median(r["seconds"] for r in runs)
+            frame = min(r["frame_seconds"] for r in runs)
+            tile = min(r["seconds"] for r in runs)
             sec = [r.get("secondary") for r in runs]
-            look = statistics.median(s["seconds"] for s in sec) if sec[0] else 0.0
+            look = min(s["seconds"] for s in sec) if sec[0] else 0.0
             s = sec[0] or {"shadow_rays": 0, "ao_rays": 0, "layer_rays": 0}
             rays = s["shadow_rays"] + s["ao_rays"] + s["layer_rays"]
             base = base or frame

@@ -50,9 +50,6 @@ struct SecondaryCounters {
 struct Opacities {
     std::span<const double> alpha;
     double of(int iso) const { return size_t(iso) < alpha.size() ? alpha[size_t(iso)] : 1.0; }
-    bool all_opaque() const {
-        return std::all_of(alpha.begin(), alpha.end(), [](double a) { return a >= 1.0; });
-    }
 };
 
 /// The world point at distance t along `ray`.
