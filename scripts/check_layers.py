@@ -21,7 +21,7 @@ LAYERS = [
                  "src/render/traverse.h", "src/render/root_finder.cpp"]),
     ("scene", ["src/scene/"]),
     ("frame", ["include/octiso/render.h", "include/octiso/debug_trace.h", "include/octiso/antialias.h", "src/render/"]),
-    ("api", ["include/octiso/any_octree.h", "include/octiso/value_stats.h", "include/octiso/shading.h", "src/api/"]),
+    ("api", ["include/octiso/any_octree.h", "include/octiso/value_stats.h", "include/octiso/shading.h", "include/octiso/look.h", "src/api/"]),
     ("io", ["include/octiso/reader.h", "include/octiso/image.h", "include/octiso/volume_writer.h", "src/io/"]),
     ("convert", ["include/octiso/convert.h", "src/convert/"]),
     ("reference", ["src/reference/"]),

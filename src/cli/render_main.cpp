@@ -14,12 +14,14 @@
 #include "cli/common/progress.h"
 #include "cli/common/report.h"
 #include "cli/render_camera.h"
+#include "cli/render_look.h"
 #include "octiso/antialias.h"
 #include "octiso/shading.h"
 #include "octiso/any_octree.h"
 #include "octiso/debug_trace.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
+#include "octiso/look.h"
 #include "octiso/oct_file.h"
 #include "octiso/output_guard.h"
 #include "octiso/render.h"
@@ -73,11 +75,11 @@ const char* kUsage =
 int run(std::vector<std::string>& argv) {
     cli::Args args(argv);
     if (args.flag("--help") || args.flag("-h")) {
-        std::cout << kUsage;
+        std::cout << kUsage << cli::kLookUsage;
         return 0;
     }
     if (argv.empty()) {   // the same in every tool: the help, as a usage error
-        std::cerr << kUsage;
+        std::cerr << kUsage << cli::kLookUsage;
         return 2;
     }
     const auto iso_text = args.value("--iso");
@@ -92,6 +94,7 @@ int run(std::vector<std::string>& argv) {
     const bool no_embree = args.flag("--no-embree"), json = args.flag("--json");
     const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
+    const cli::LookFlags look_flags = cli::LookFlags::take(args);   // issue 17 item 7
     const std::vector<std::string> inputs = args.positional();
     args.finish();
     if (inputs.size() != 1) throw Error("octiso-render", "expected exactly one FILE.oct (octiso-render --help lists every flag)");
@@ -130,9 +133,13 @@ int run(std::vector<std::string>& argv) {
         throw Error("--colour", "given " + std::to_string(colour_texts.size()) + " times for " + std::to_string(options.isovalues.size()) +
                                     " isovalue(s) (the k-th --colour colours the k-th isovalue)");
     for (const std::string& c : colour_texts) shading.colours.push_back(parse_colour(c, "--colour"));
+    // Issue 17 item 7: clip planes cut every ray; shadows, AO and opacity shade through LookShader.
+    options.clip_planes = look_flags.clip_planes;
+    const Look& look = look_flags.look;
+    validate_look(look, options.isovalues.size(), shading.model);
     // The colour is shaded after tracing, from the depth and normal AOVs (shading.h), unless the
     // Renderer's own headlight is asked for as it is: that path stays bit for bit the old image.
-    const bool deferred = out_path && (shading.model == ShadingModel::kit || background_text || !colour_texts.empty());
+    const bool deferred = out_path && (shading.model == ShadingModel::kit || background_text || !colour_texts.empty() || look.active());
     RenderOptions trace_options = options;
     if (deferred) trace_options.want_colour = false, trace_options.want_depth = trace_options.want_normal = true;
 
@@ -233,6 +240,7 @@ int run(std::vector<std::string>& argv) {
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
+        cli::write_look_json(j, look, options.clip_planes);   // issue 17 item 7
         j.key("camera");
         camera_json(cameras[0]);
         j.key("frames").begin_array();
@@ -241,6 +249,7 @@ int run(std::vector<std::string>& argv) {
     double total_seconds = 0;
     std::optional<Renderer> renderer;
     std::optional<AnyOctree> step_tree;
+    std::optional<LookShader> look_shader;
     long long renderer_step = -1;
     for (size_t n = 0; n < jobs.size(); ++n) {
         const Job& job = jobs[n];
@@ -250,12 +259,15 @@ int run(std::vector<std::string>& argv) {
             renderer.reset();
             step_tree.emplace(AnyOctree::step(file, uint32_t(job.step)));
             renderer.emplace(step_tree->make_renderer(trace_options));
+            if (deferred && look.active()) look_shader.emplace(*step_tree, trace_options, look, shading.model);
             renderer_step = job.step;
         }
         Frame frame;
+        LookStats look_stats;
         const auto t0 = std::chrono::steady_clock::now();
         render_antialiased(*renderer, *job.camera, spp, frame, deferred ? SampleShader([&](const Camera& c, Frame& f) {
-            shade_frame(*step_tree, options.isovalues, c, shading, f);
+            if (look_shader) look_stats.add(look_shader->shade(c, shading, f));
+            else shade_frame(*step_tree, options.isovalues, c, shading, f);
         }) : SampleShader());
         // The whole frame: every sample traced and shaded (frame.stats.seconds: the tile loops only).
         const double frame_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -276,6 +288,7 @@ int run(std::vector<std::string>& argv) {
             j.field("mrays_per_second", frame.stats.mrays_per_second()).field("rays", frame.stats.rays);
             j.field("hits", frame.stats.hits).field("threads", frame.stats.threads);
             if (out_path) j.field("image", name_for(out_path, "-o", job.index));
+            if (look_shader) cli::write_look_stats_json(j, look_stats);
             j.key("camera");
             camera_json(*job.camera);
             j.end_object();
@@ -287,6 +300,7 @@ int run(std::vector<std::string>& argv) {
                          frame.stats.seconds, frame.stats.mrays_per_second(), (unsigned long long)frame.stats.hits,
                          frame.stats.threads, spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
                          orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
+        if (look_shader && (!series || !::isatty(2))) cli::print_look_stats(look_stats);
         progress.update(double(n + 1), double(jobs.size()), std::to_string(n + 1) + "/" + std::to_string(jobs.size()) + " frames");
     }
     progress.finish();
