@@ -9,6 +9,9 @@ numpy in, images out::
     for az in range(0, 360, 30):
         image = r.render(octiso.Camera.frame(tree, azimuth=az)).rgb
 
+Isovalues and the ranges of Tree.info() are real values, as the tools take and report them:
+for a NIfTI with scl_slope/scl_inter, real = stored * slope + inter (info()['value_scale']).
+
 Errors carry the command-line tools' one-line messages: ValueError for bad arguments, OSError
 for files, TypeError for arrays of a type octiso does not store.
 """

@@ -8,6 +8,7 @@ __version__: str
 
 Vec3 = Sequence[float]
 Size = Tuple[int, int]
+# Isovalues are real values: a scaled NIfTI's stored * slope + inter (Tree.info()['value_scale']).
 Iso = Union[float, Sequence[float]]
 
 class Camera:

@@ -1,8 +1,11 @@
 // Camera, Frame and Renderer for Python: a Renderer is the library's persistent Renderer (its
 // Embree scene and thread arena are kept between frames: isovalue sweeps and orbits pay them
 // once); Tree.render is the one-call form. A Frame's arrays adopt the rendered buffers (no copy).
+// Isovalues are real values (CONVENTIONS 2b: a scaled NIfTI's stored * slope + inter), turned
+// into the stored values the tree holds here, exactly as octiso-render turns its --iso.
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -11,6 +14,7 @@
 #include "bindings.h"
 #include "octiso/any_octree.h"
 #include "octiso/camera.h"
+#include "octiso/error.h"
 #include "octiso/render.h"
 
 namespace octiso::python {
@@ -39,11 +43,30 @@ std::vector<double> isovalues_of(const py::object& iso) {
     }
 }
 
-RenderOptions options_of(const py::object& iso, int threads, bool depth, bool normal, const std::string& root_finder,
-                         int iterations) {
+/// The stored isovalues of `tree` for the real ones `real` (ValueScale::stored, the tools' own
+/// conversion, so a frame here equals octiso-render's for the same --iso). An iso-range is
+/// checked here in real values, so the message names the numbers the caller gave; the Renderer
+/// checks the same thing again on the stored ones.
+std::vector<double> stored_isovalues(const AnyOctree& tree, const std::vector<double>& real) {
+    const AnyOctreeInfo info = tree.info();
+    std::vector<double> stored;
+    for (const double v : real) {
+        const double s = info.value_scale.stored(v);
+        if (info.iso_range && std::isfinite(v) && !(s > (*info.iso_range)[0] && s < (*info.iso_range)[1])) {
+            const std::array<double, 2> r = info.value_scale.real_range(*info.iso_range);
+            throw Error("iso", "isovalue " + std::to_string(v) + " lies outside the iso-range (" + std::to_string(r[0]) + ", " +
+                                   std::to_string(r[1]) + ") of " + info.source + " (real values)");
+        }
+        stored.push_back(s);
+    }
+    return stored;
+}
+
+RenderOptions options_of(const AnyOctree& tree, const std::vector<double>& real_iso, int threads, bool depth, bool normal,
+                         const std::string& root_finder, int iterations) {
     if (threads < 0) throw py::value_error("threads: must be >= 0 (0: all cores)");
     RenderOptions o;
-    o.isovalues = isovalues_of(iso);
+    o.isovalues = stored_isovalues(tree, real_iso);
     o.threads = threads;
     o.want_depth = depth;
     o.want_normal = normal;
@@ -83,7 +106,8 @@ PyFrame to_python(Frame&& f) {
 struct PyRenderer {
     AnyOctree tree;
     Renderer renderer;
-    std::array<int, 2> size;   ///< frame width, height
+    std::array<int, 2> size;     ///< frame width, height
+    std::vector<double> iso;     ///< the real isovalues as given (the renderer holds the stored ones)
 };
 
 }  // namespace
@@ -136,19 +160,22 @@ Without angles: the same three-quarter view as octiso-render without camera flag
     py::class_<PyRenderer>(m, "Renderer", "Renders frame after frame of one Tree, keeping its Embree scene and threads between calls.")
         .def(py::init([](const AnyOctree& tree, const py::object& iso, const py::object& size, int threads, bool depth, bool normal,
                          const std::string& root_finder, int iterations) {
-                 const RenderOptions o = options_of(iso, threads, depth, normal, root_finder, iterations);
+                 const std::vector<double> real = isovalues_of(iso);
+                 const RenderOptions o = options_of(tree, real, threads, depth, normal, root_finder, iterations);
                  const std::array<int, 2> wh = size_of(size);
                  py::gil_scoped_release release;
-                 return std::make_unique<PyRenderer>(PyRenderer{tree, tree.make_renderer(o), wh});
+                 return std::make_unique<PyRenderer>(PyRenderer{tree, tree.make_renderer(o), wh, real});
              }),
              py::arg("tree"), py::arg("iso"), py::arg("size") = py::make_tuple(512, 512), py::arg("threads") = 0,
              py::arg("depth") = false, py::arg("normal") = false, py::arg("root_finder") = "neubauer", py::arg("iterations") = -1)
-        .def_property("iso", [](const PyRenderer& r) { return r.renderer.options().isovalues; },
+        .def_property("iso", [](const PyRenderer& r) { return r.iso; },
                       [](PyRenderer& r, const py::object& iso) {
                           RenderOptions o = r.renderer.options();
-                          o.isovalues = isovalues_of(iso);
+                          const std::vector<double> real = isovalues_of(iso);
+                          o.isovalues = stored_isovalues(r.tree, real);
                           r.renderer.set_options(o);
-                      }, "the isovalues; setting them keeps the scene")
+                          r.iso = real;
+                      }, "the isovalues in real values (stored * slope + inter of Tree.info()['value_scale']); setting them keeps the scene")
         .def("render", [](const PyRenderer& r, const std::optional<Camera>& camera) {
             const Camera c = camera_for(r.tree, camera, r.size);
             Frame f;
@@ -166,7 +193,7 @@ void add_tree_render(py::class_<AnyOctree>& tree_class) {
         "render",
         [](const AnyOctree& tree, const py::object& iso, const std::optional<Camera>& camera, const py::object& size, int threads,
            bool depth, bool normal, const std::string& root_finder) {
-            const RenderOptions o = options_of(iso, threads, depth, normal, root_finder, -1);
+            const RenderOptions o = options_of(tree, isovalues_of(iso), threads, depth, normal, root_finder, -1);
             const Camera c = camera_for(tree, camera, size_of(size));
             Frame f;
             {
@@ -177,7 +204,8 @@ void add_tree_render(py::class_<AnyOctree>& tree_class) {
         },
         py::arg("iso"), py::arg("camera") = py::none(), py::arg("size") = py::make_tuple(512, 512), py::arg("threads") = 0,
         py::arg("depth") = false, py::arg("normal") = false, py::arg("root_finder") = "neubauer",
-        R"(Renders the isosurface(s) `iso` (a number or up to 8) into a Frame of `size` (width, height):
+        R"(Renders the isosurface(s) `iso` (a number or up to 8, real values: the tree's value_scale applied,
+as octiso-render --iso) into a Frame of `size` (width, height):
 with `camera`, or the default three-quarter framing. depth/normal add those outputs. The GIL is released.)");
 }
 

@@ -59,12 +59,19 @@ py::dict info_dict(const AnyOctree& tree) {
     d["spacing"] = py::make_tuple(info.placement.spacing[0], info.placement.spacing[1], info.placement.spacing[2]);
     d["origin"] = py::make_tuple(info.placement.origin[0], info.placement.origin[1], info.placement.origin[2]);
     d["dmax"] = info.dmax;
-    d["value_range"] = info.value_range ? py::object(py::make_tuple((*info.value_range)[0], (*info.value_range)[1])) : py::none();
-    d["iso_range"] = info.iso_range ? py::object(py::make_tuple((*info.iso_range)[0], (*info.iso_range)[1])) : py::none();
-    d["tolerance"] = info.tolerance;
     // Stored-to-real values (a NIfTI's scl_slope/scl_inter): real = stored * slope + inter. The
-    // ranges above and the isovalues render() takes are stored values here, as in the C++ API.
-    d["value_scale"] = py::make_tuple(info.value_scale.slope, info.value_scale.inter);
+    // ranges are real values, as the tools report them and as render() takes isovalues
+    // (CONVENTIONS 2b); the tolerance stays in stored units, as the C++ API records it.
+    const ValueScale& scale = info.value_scale;
+    const auto real = [&](const std::optional<std::array<double, 2>>& stored) {
+        if (!stored) return py::object(py::none());
+        const std::array<double, 2> r = scale.real_range(*stored);
+        return py::object(py::make_tuple(r[0], r[1]));
+    };
+    d["value_range"] = real(info.value_range);
+    d["iso_range"] = real(info.iso_range);
+    d["tolerance"] = info.tolerance;
+    d["value_scale"] = py::make_tuple(scale.slope, scale.inter);
     d["flipped_axes"] = int(info.flipped_axes);
     d["interior_bytes"] = info.sizes.interior_bytes;
     d["minmax_bytes"] = info.sizes.minmax_bytes;
@@ -112,7 +119,7 @@ step of a .oct file (octiso.open(...).step(k)). Immutable; copies share the same
             const auto& o = t.placement().origin;
             return py::make_tuple(o[0], o[1], o[2]);
         }, "world position of voxel (0, 0, 0)")
-        .def("info", &info_dict, "A dict: type, dims, shape, spacing, origin, dmax, value_range, iso_range, tolerance, value_scale (slope, inter: real = stored * slope + inter), flipped_axes, byte counts, nodes and scalar leaves per depth, source.")
+        .def("info", &info_dict, "A dict: type, dims, shape, spacing, origin, dmax, value_range, iso_range, tolerance, value_scale (slope, inter: real = stored * slope + inter; value_range and iso_range are real values, tolerance stored), flipped_axes, byte counts, nodes and scalar leaves per depth, source.")
         .def("to_numpy", &to_numpy, "The voxels back as a new array of shape (nz, ny, nx), exactly as built (lossless trees).")
         .def("save", [](const AnyOctree& t, const std::string& path) {
             py::gil_scoped_release release;

@@ -54,16 +54,21 @@ std::string json_string(const std::string& s) {
 
 std::string json_number(double v) { return std::isfinite(v) ? exact(v) : "null"; }
 
+/// /info in real values: the ranges mapped by the file's value_scale (ends swapped by a negative
+/// slope), the scale itself given so the page can say what the numbers are.
 std::string build_info_json(const std::string& path, const OctInfo& info, const AnyOctreeInfo& step0, const Histogram& h,
                             std::optional<double> initial_iso) {
     std::string j = "{\"file\":" + json_string(path) + ",\"type\":" + json_string(std::string(scalar_type_name(info.type)));
     j += ",\"dims\":[" + std::to_string(info.dims.x) + "," + std::to_string(info.dims.y) + "," + std::to_string(info.dims.z) + "]";
     j += ",\"spacing\":[" + vec3(info.placement.spacing) + "],\"origin\":[" + vec3(info.placement.origin) + "]";
     j += ",\"steps\":" + std::to_string(info.step_count);
-    auto range = [&](const std::optional<std::array<double, 2>>& r) {
-        return r ? "[" + json_number((*r)[0]) + "," + json_number((*r)[1]) + "]" : std::string("null");
+    auto range = [&](const std::optional<std::array<double, 2>>& stored) {
+        if (!stored) return std::string("null");
+        const std::array<double, 2> r = info.value_scale.real_range(*stored);
+        return "[" + json_number(r[0]) + "," + json_number(r[1]) + "]";
     };
     j += ",\"value_range\":" + range(step0.value_range) + ",\"iso_range\":" + range(info.iso_range);
+    j += ",\"value_scale\":[" + exact(info.value_scale.slope) + "," + exact(info.value_scale.inter) + "]";
     j += ",\"initial_iso\":" + (initial_iso ? json_number(*initial_iso) : std::string("null"));
     j += ",\"histogram\":{\"lo\":" + json_number(h.lo) + ",\"hi\":" + json_number(h.hi) + ",\"counts\":[";
     for (size_t i = 0; i < h.counts.size(); ++i) j += (i ? "," : "") + std::to_string(h.counts[i]);
@@ -77,9 +82,11 @@ std::string build_info_json(const std::string& path, const OctInfo& info, const 
 
 Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_bytes) {
     Histogram h;
-    const auto range = step.info().value_range;
-    if (!range) return h;
-    h.lo = (*range)[0], h.hi = (*range)[1];
+    const AnyOctreeInfo info = step.info();
+    if (!info.value_range) return h;
+    const ValueScale scale = info.value_scale;
+    const std::array<double, 2> range = scale.real_range(*info.value_range);
+    h.lo = range[0], h.hi = range[1];
     if (step.dense_bytes() > max_dense_bytes || bins <= 0) return h;
     std::vector<std::byte> dense(step.dense_bytes());
     step.decode(dense);
@@ -91,7 +98,7 @@ Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_by
         for (size_t i = 0; i < n; ++i) {
             T v;
             std::memcpy(&v, dense.data() + i * sizeof(T), sizeof(T));   // no alignment assumed
-            const double x = double(v);
+            const double x = scale.real(double(v));   // the same map as the range's ends
             // value_range covers data cells only (an extent-1 border voxel can lie outside it).
             if (!(x >= h.lo && x <= h.hi)) continue;
             const double f = width > 0 ? (x - h.lo) / width * bins : 0.0;
@@ -116,15 +123,24 @@ std::string render_command(const std::string& path, const Camera& camera, double
 ViewSession::ViewSession(const std::string& path, int threads, std::optional<double> initial_iso)
     : path_(path), threads_(threads), file_(std::make_shared<const OctFile>(OctFile::open(path))) {
     if (file_->info().step_count == 0) throw Error(path, "the file has no steps");
+    scale_ = file_->info().value_scale;
     renderers_.resize(file_->info().step_count);
     const AnyOctree step0 = AnyOctree::step(file_, 0);   // validated now: a bad file fails before serving
     histogram_ = value_histogram(step0, 128, uint64_t(1) << 30);
-    if (initial_iso) {   // refused now, not as a first frame the page cannot show
-        RenderOptions options;
-        options.isovalues = {*initial_iso};
-        validate_options(options, step0.render_limits());
-    }
+    if (initial_iso) check_iso_range(*initial_iso, "--iso");   // refused now, not as a first frame the page cannot show
     info_json_ = build_info_json(path_, file_->info(), step0.info(), histogram_, initial_iso);
+}
+
+void ViewSession::check_iso_range(double real_iso, const std::string& subject) const {
+    // The Renderer checks the stored value against the stored iso-range too (validate_options),
+    // but names both in stored values; this is the same test, worded in the values the user sees.
+    const auto& stored_range = file_->info().iso_range;
+    if (!stored_range) return;
+    const double stored = scale_.stored(real_iso);
+    if (stored > (*stored_range)[0] && stored < (*stored_range)[1]) return;
+    const std::array<double, 2> r = scale_.real_range(*stored_range);
+    throw Error(subject, "isovalue " + exact(real_iso) + " lies outside the file's iso-range (" + exact(r[0]) + ", " + exact(r[1]) +
+                             "): the data there was clamped when " + path_ + " was converted");
 }
 
 Camera ViewSession::camera_for(const FrameRequest& r) const {
@@ -134,8 +150,12 @@ Camera ViewSession::camera_for(const FrameRequest& r) const {
 
 FrameReply ViewSession::render(const FrameRequest& request) {
     if (request.step >= renderers_.size()) throw Error("step", "out of range");
+    check_iso_range(request.iso, "iso");
     RenderOptions options;
-    options.isovalues = {request.iso};
+    // CONVENTIONS 2b: the page's isovalue is real; the tree holds stored values. The same
+    // conversion as octiso-render's (ValueScale::stored of the same double), so the offered
+    // command, which carries the real value, traces the same stored isovalue bit for bit.
+    options.isovalues = {scale_.stored(request.iso)};
     options.threads = threads_;
     // The kernel directly, without Embree's dispatch: the same pixels (RenderPaths.
     // EmbreeAndDirectGiveIdenticalFrames), 1-5 % less per frame (BENCHMARKS.md, packets).

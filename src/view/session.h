@@ -1,8 +1,9 @@
 // ViewSession: what octiso-view serves, apart from HTTP: the opened .oct file, one persistent
 // Renderer per series step (built on first use and kept), the /info description (dims, value
 // range, histogram, steps) and, for each frame, its pixels (PNG or raw RGBA) with its camera,
-// statistics and the octiso-render command line that reproduces it. Coalescing and routes are
-// server.h.
+// statistics and the octiso-render command line that reproduces it. Every value the page sees or
+// sends is a real value (CONVENTIONS 2b: a scaled NIfTI's stored * slope + inter); the session
+// turns isovalues into stored ones exactly as octiso-render does. Coalescing and routes are server.h.
 #pragma once
 
 #include <array>
@@ -30,7 +31,7 @@ struct FrameReply {
     std::string command;   ///< octiso-render ... reproducing these pixels exactly (shell-quoted)
 };
 
-/// Counts of a value histogram over [lo, hi] in `counts.size()` equal bins (hi in the last).
+/// Counts of a value histogram over [lo, hi] (real values) in `counts.size()` equal bins (hi in the last).
 struct Histogram {
     double lo = 0, hi = 0;
     std::vector<uint64_t> counts;
@@ -40,11 +41,12 @@ class ViewSession {
 public:
     /// Opens `path` (OctFile::open: header and tables checked; step 0 validated here, so a bad
     /// file fails before the server starts). Throws Error(path, ...). threads: 0 = all cores.
-    /// initial_iso: the isovalue the page starts at (/info "initial_iso"); none: the middle of the range.
+    /// initial_iso: the real isovalue the page starts at (/info "initial_iso"); none: the middle of the range.
     ViewSession(const std::string& path, int threads, std::optional<double> initial_iso = {});
 
     /// Renders `request` (its step's Renderer made on first use). Not thread-safe: callers
-    /// serialise (the Coalescer does). Throws Error for an isovalue the file cannot render.
+    /// serialise (the Coalescer does). request.iso is a real value. Throws Error("iso", ...) for an
+    /// isovalue the file cannot render (outside its iso-range, named in real values).
     FrameReply render(const FrameRequest& request);
 
     /// The camera of a request: orbit_camera around the data centre (camera.h).
@@ -55,21 +57,28 @@ public:
     const Histogram& histogram() const { return histogram_; }
 
 private:
+    /// Throws Error(subject, ...) unless the real isovalue's stored value lies strictly inside the
+    /// file's iso-range (when it has one); the message names the range in real values.
+    void check_iso_range(double real_iso, const std::string& subject) const;
+
     std::string path_;
     int threads_;
     std::shared_ptr<const OctFile> file_;
+    ValueScale scale_;                                   // the file's stored-to-real values
     std::vector<std::unique_ptr<Renderer>> renderers_;   // per step, null until first used
     Frame frame_;                                        // reused: buffers kept between frames
     Histogram histogram_;
     std::string info_json_;
 };
 
-/// Step 0's stored values in `bins` bins over [range lo, hi]; decoded only when the dense array
-/// is at most `max_dense_bytes` (else counts is empty: the page draws no histogram).
+/// Step 0's values as real values (its value_scale applied) in `bins` bins over its real value
+/// range; decoded only when the dense array is at most `max_dense_bytes` (else counts is empty:
+/// the page draws no histogram).
 Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_bytes);
 
-/// The octiso-render command line for `camera` and `iso` on `path` (step `step` of a file of
-/// `step_count` steps): numbers in the shortest form that reads back to the same double.
+/// The octiso-render command line for `camera` and the real isovalue `iso` on `path` (step `step`
+/// of a file of `step_count` steps): numbers in the shortest form that reads back to the same
+/// double, so octiso-render converts the same real value to the same stored one.
 std::string render_command(const std::string& path, const Camera& camera, double iso, uint32_t step, uint32_t step_count);
 
 }  // namespace octiso::view

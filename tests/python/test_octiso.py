@@ -225,3 +225,57 @@ def test_convert_matches_the_tool_byte_for_byte(tmp_path):
         octiso.convert(str(raw), str(raw), dims=(17, 13, 11), dtype="uint16")
     with pytest.raises(ValueError):
         octiso.convert(str(raw), mine, dims=(17, 13, 11), dtype="u16", endian="middle")
+
+
+def write_scaled_nifti(path, volume, slope, inter):
+    """A NIfTI-1 file (header by the standard's byte offsets, as tests/io/nifti_test_file.h writes
+    it) of an int16 [z, y, x] array with scl_slope/scl_inter, independent of octiso's reader."""
+    import struct
+    nz, ny, nx = volume.shape
+    h = bytearray(352)
+    struct.pack_into("<i", h, 0, 348)
+    struct.pack_into("<8h", h, 40, 3, nx, ny, nz, 1, 1, 1, 1)
+    struct.pack_into("<hh", h, 70, 4, 16)                      # datatype int16, bitpix
+    struct.pack_into("<8f", h, 76, 1, 1, 1, 1, 1, 1, 1, 1)     # pixdim (qfac 1)
+    struct.pack_into("<fff", h, 108, 352.0, slope, inter)      # vox_offset, scl_slope, scl_inter
+    h[344:348] = b"n+1\0"
+    with open(path, "wb") as f:
+        f.write(bytes(h) + volume.astype("<i2").tobytes())
+
+
+def test_isovalues_and_ranges_are_real_values_of_a_scaled_nifti(tmp_path):
+    """CONVENTIONS 2b: real = stored * slope + inter. render() and Renderer take real isovalues and
+    draw what octiso-render draws for the same --iso; info() reports the real ranges."""
+    if not TOOLS:
+        pytest.fail("OCTISO_TOOLS_DIR must name the build directory with octiso-render")
+    a = np.round(field((30, 28, 26), np.float32)).astype(np.int16)
+    nii, path = str(tmp_path / "s.nii"), str(tmp_path / "s.oct")
+    write_scaled_nifti(nii, a, 0.5, -10)
+    octiso.convert(nii, path)
+    tree = octiso.open(path).step(0)
+    info = tree.info()
+    assert info["value_scale"] == (0.5, -10.0)
+    assert np.array_equal(tree.to_numpy(), a)                  # the tree keeps the stored values
+    lo, hi = info["value_range"]
+    assert (lo, hi) == (0.5 * int(a.min()) - 10, 0.5 * int(a.max()) - 10)
+    real_iso, stored_iso = 20.25, 60.5                        # 60.5 * 0.5 - 10
+    png = str(tmp_path / "tool.png")
+    subprocess.run([os.path.join(TOOLS, "octiso-render"), path, "--iso", str(real_iso), "--size", "64x48", "-o", png,
+                    "--shading", "headlight"], check=True, capture_output=True)
+    frame = tree.render(real_iso, size=(64, 48))
+    assert frame.hits > 300
+    assert np.array_equal(frame.rgb, read_png(png))
+    # The same surface as the stored isovalue in an unscaled tree of the same voxels.
+    assert np.array_equal(frame.rgb, octiso.build(a).render(stored_iso, size=(64, 48)).rgb)
+    r = octiso.Renderer(tree, 0.0, size=(64, 48))
+    r.iso = real_iso
+    assert r.iso == [real_iso]
+    assert np.array_equal(r.render().rgb, frame.rgb)
+    # An iso-range given in real values is checked and named in real values.
+    ranged = str(tmp_path / "r.oct")
+    octiso.convert(nii, ranged, iso_range=(0, 30))
+    rt = octiso.open(ranged).step(0)
+    assert rt.info()["iso_range"] == (0.0, 30.0)
+    assert rt.render(real_iso, size=(8, 8)).rays == 64
+    with pytest.raises(ValueError, match=r"outside the iso-range \(0\.000000, 30\.000000\)"):
+        rt.render(31, size=(8, 8))
