@@ -31,7 +31,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
               r.zoom >= octiso::view::kMinZoom && r.zoom <= octiso::view::kMaxZoom &&
               r.elevation_deg >= -octiso::view::kMaxElevationDeg && r.elevation_deg <= octiso::view::kMaxElevationDeg &&
               r.iso - r.iso == 0 && r.azimuth_deg - r.azimuth_deg == 0 &&
-              (r.encoding == octiso::view::FrameEncoding::png || r.encoding == octiso::view::FrameEncoding::rgba)))
+              (r.encoding == octiso::view::FrameEncoding::png || r.encoding == octiso::view::FrameEncoding::rgba) &&
+              r.ao_samples >= 0 && r.ao_samples <= octiso::view::kMaxViewAoSamples))
             __builtin_trap();
     } catch (const octiso::Error&) {
     }

@@ -57,7 +57,9 @@ FrameRequest parse_frame_request(const QueryParameters& parameters, uint32_t ste
         throw Error("query", "too many parameters (at most " + std::to_string(kMaxParameters) + ")");
     // Each known name once; the bit says it was seen, so a repeat is caught (a proxy or a hand-
     // made URL could send "iso=1&iso=2", and which one wins would be a guess).
-    enum : unsigned { kIso = 1, kAz = 2, kEl = 4, kZoom = 8, kW = 16, kH = 32, kStep = 64, kSeq = 128, kEnc = 256 };
+    enum : unsigned {
+        kIso = 1, kAz = 2, kEl = 4, kZoom = 8, kW = 16, kH = 32, kStep = 64, kSeq = 128, kEnc = 256, kShadows = 512, kAo = 1024
+    };
     unsigned seen = 0;
     FrameRequest r;
     for (const auto& [name, value] : parameters) {
@@ -71,6 +73,8 @@ FrameRequest parse_frame_request(const QueryParameters& parameters, uint32_t ste
         else if (name == "step") bit = kStep;
         else if (name == "seq") bit = kSeq;
         else if (name == "enc") bit = kEnc;
+        else if (name == "shadows") bit = kShadows;
+        else if (name == "ao") bit = kAo;
         else throw Error(name.size() <= kMaxValueLength ? name : name.substr(0, kMaxValueLength) + "...", "unknown parameter");
         if (seen & bit) throw Error(name, "given more than once");
         seen |= bit;
@@ -92,6 +96,12 @@ FrameRequest parse_frame_request(const QueryParameters& parameters, uint32_t ste
                 else if (value == "rgba") r.encoding = FrameEncoding::rgba;
                 else throw Error(name, "expected png or rgba, found '" + value + "'");
                 break;
+            case kShadows:   // exactly what the page sends: no "true", "on" or "01" to guess at
+                if (value == "0") r.shadows = false;
+                else if (value == "1") r.shadows = true;
+                else throw Error(name, "expected 0 or 1, found '" + value + "'");
+                break;
+            case kAo: r.ao_samples = int(to_integer(name, value, 0, kMaxViewAoSamples)); break;
             default: r.seq = to_counter(name, value); break;
         }
     }

@@ -1,5 +1,6 @@
 // The viewer's request parameters: the query of GET /frame (isovalue, orbit angles, zoom, image
-// size, series step, client sequence number) parsed and bounded before anything is rendered. The
+// size, series step, client sequence number, encoding, shadows and ambient occlusion) parsed and
+// bounded before anything is rendered. The
 // only untrusted text the viewer reads (the HTTP framing itself is cpp-httplib's); fuzz/
 // fuzz_view_request.cpp feeds it arbitrary bytes. Rendering and replies are session.h and server.h.
 #pragma once
@@ -19,6 +20,10 @@ inline constexpr size_t kMaxParameters = 16;                ///< name=value pair
 inline constexpr size_t kMaxValueLength = 64;               ///< characters of one value
 inline constexpr double kMaxElevationDeg = 89.0;            ///< |elevation| < 90 keeps z-up defined
 inline constexpr double kMinZoom = 0.05, kMaxZoom = 50.0;
+/// Ambient-occlusion rays per hit a frame may ask for. The page asks for 8 (its AO toggle); the
+/// bound keeps the worst frame within 16 secondary rays per pixel of kMaxImagePixels, against
+/// octiso-render's kMaxAoSamples (256) for a batch render someone chose to wait for.
+inline constexpr int kMaxViewAoSamples = 16;
 
 /// How a frame's pixels travel. png: lossless and compact (OpenImageIO, zlib level 1; 105 KB for
 /// ch2better at 512^2), for a page on another machine; rgba: the tile loop's colour as raw 8-bit
@@ -29,10 +34,11 @@ inline constexpr double kMinZoom = 0.05, kMaxZoom = 50.0;
 enum class FrameEncoding { png, rgba };
 
 /// One frame asked for: the camera of orbit_camera(dims, placement, width, height, azimuth_deg,
-/// elevation_deg, zoom) and the isovalue `iso` of series step `step`.
+/// elevation_deg, zoom) and the real isovalue `iso` of series step `step`; with shadows or
+/// ao_samples > 0, the light kit through LookShader (octiso-render --shadows, --ao N).
 /// Invariants after parse_frame_request: iso, azimuth_deg finite; |elevation_deg| <= kMaxElevationDeg;
 /// zoom in [kMinZoom, kMaxZoom]; 1 <= width, height <= kMaxImageSide, width*height <= kMaxImagePixels;
-/// step < the file's step count.
+/// step < the file's step count; 0 <= ao_samples <= kMaxViewAoSamples.
 struct FrameRequest {
     double iso = 0;
     double azimuth_deg = 0, elevation_deg = 0, zoom = 1;
@@ -40,13 +46,15 @@ struct FrameRequest {
     uint32_t step = 0;
     uint64_t seq = 0;   ///< the client's counter, echoed back so it can drop replies older than shown
     FrameEncoding encoding = FrameEncoding::png;
+    bool shadows = false;   ///< shadow rays toward the light kit's key light
+    int ao_samples = 0;     ///< ambient-occlusion rays per hit; 0 off
 };
 
 using QueryParameters = std::vector<std::pair<std::string, std::string>>;
 
 /// Parses the (already percent-decoded) name/value pairs of a /frame query for a file of
-/// `step_count` steps. iso, az, el, w, h are required; zoom (1), step (0), seq (0) and
-/// enc (png; or rgba) optional.
+/// `step_count` steps. iso, az, el, w, h are required; zoom (1), step (0), seq (0), enc (png; or
+/// rgba), shadows (0; or 1) and ao (0 .. kMaxViewAoSamples, 0) optional.
 /// Throws Error(parameter name, problem) for a missing, repeated, unknown, malformed or out-of-
 /// bounds parameter. Numbers are plain decimal (no sign '+', no spaces, no inf/nan, no hex).
 FrameRequest parse_frame_request(const QueryParameters& parameters, uint32_t step_count);

@@ -71,13 +71,14 @@ struct ViewServer::Impl {
                 res.set_header("X-Octiso-Superseded", "1");
                 return;
             }
-            char stats[320];
+            // look: the shadow/AO pass after the tile loop (seconds), secondary: its rays.
+            char stats[400];
             std::snprintf(stats, sizeof stats,
-                          "seconds=%.6f;encode=%.6f;wait=%.6f;server=%.6f;rays=%llu;hits=%llu;threads=%d;mrays=%.3f",
+                          "seconds=%.6f;encode=%.6f;wait=%.6f;server=%.6f;rays=%llu;hits=%llu;threads=%d;mrays=%.3f;look=%.6f;secondary=%llu",
                           reply->stats.seconds, reply->encode_seconds, wait_seconds,
                           std::chrono::duration<double>(std::chrono::steady_clock::now() - entered).count(),
                           (unsigned long long)reply->stats.rays, (unsigned long long)reply->stats.hits, reply->stats.threads,
-                          reply->stats.mrays_per_second());
+                          reply->stats.mrays_per_second(), reply->look.seconds, (unsigned long long)reply->look.secondary_rays());
             res.set_header("X-Octiso-Stats", stats);
             res.set_header("X-Octiso-Command", percent_encode(reply->command));
             res.set_header("X-Octiso-Size", std::to_string(reply->camera.width) + "x" + std::to_string(reply->camera.height));

@@ -1,14 +1,15 @@
 // ViewServer: octiso-view's HTTP face (cpp-httplib). Exactly three routes, all GET:
 //   /       the page (web/viewer.html, compiled into the binary; no file is ever read for a request)
 //   /info   ViewSession::info_json()
-//   /frame  ?iso=&az=&el=&zoom=&w=&h=&step=&seq=&enc=  (request.h) -> image/png (enc=png, the
+//   /frame  ?iso=&az=&el=&zoom=&w=&h=&step=&seq=&enc=&shadows=&ao=  (request.h) -> image/png (enc=png, the
 //           default) or raw RGBA rows as application/octet-stream (enc=rgba; X-Octiso-Size WxH),
 //           or 204 with X-Octiso-Superseded: 1 when a newer frame request arrived while this one waited
 // Anything else is 404; a malformed /frame is 400 with a one-line text reason; a render error
 // (an isovalue outside the file's iso-range) 422; over the request-rate bound 429. Requests are
 // bounded in size by cpp-httplib (URI, headers) and here (no bodies). Frame statistics (render,
-// encode, wait behind another render, whole handler, in seconds) and the reproducing command
-// ride in X-Octiso-* headers (percent-encoded where they carry text).
+// encode, wait behind another render, whole handler, the look's pass, in seconds; rays, hits,
+// secondary rays) and the reproducing command ride in X-Octiso-* headers (percent-encoded where
+// they carry text).
 #pragma once
 
 #include <functional>

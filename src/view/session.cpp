@@ -10,6 +10,8 @@
 #include <cstring>
 
 #include "octiso/error.h"
+#include "octiso/look.h"
+#include "octiso/shading.h"
 #include "octiso/render.h"
 #include "octiso/volume.h"
 #include "view/png.h"
@@ -108,10 +110,15 @@ Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_by
     return h;
 }
 
-std::string render_command(const std::string& path, const Camera& camera, double iso, uint32_t step, uint32_t step_count) {
-    // The viewer shows the Renderer's own colour (headlight); octiso-render's default is the light
-    // kit (deferred shading), so the command names the headlight to reproduce the frame exactly.
-    std::string c = "octiso-render " + shell_quote(path) + " --iso " + exact(iso) + " --shading headlight";
+std::string render_command(const std::string& path, const Camera& camera, double iso, const Look& look, uint32_t step,
+                           uint32_t step_count) {
+    std::string c = "octiso-render " + shell_quote(path) + " --iso " + exact(iso);
+    // Without the look the viewer shows the Renderer's own colour (headlight); octiso-render's
+    // default is the light kit (deferred shading), so the command names the headlight to
+    // reproduce the frame exactly. Shadows and AO need the kit, octiso-render's default.
+    if (!look.active()) c += " --shading headlight";
+    if (look.shadows) c += " --shadows";
+    if (look.ao_samples > 0) c += " --ao " + std::to_string(look.ao_samples);
     c += " --eye " + vec3(camera.eye) + " --look " + vec3(camera.look) + " --up " + vec3(camera.up);
     c += " --fov " + exact(camera.fov_deg) + " --size " + std::to_string(camera.width) + "x" + std::to_string(camera.height);
     // octiso-render renders step k of a series with --steps k:k and a name pattern.
@@ -158,14 +165,29 @@ FrameReply ViewSession::render(const FrameRequest& request) {
     options.isovalues = {scale_.stored(request.iso)};
     options.threads = threads_;
     // The kernel directly, without Embree's dispatch: the same pixels (RenderPaths.
-    // EmbreeAndDirectGiveIdenticalFrames), 1-5 % less per frame (BENCHMARKS.md, packets).
+    // EmbreeAndDirectGiveIdenticalFrames, colour and AOVs), 1-5 % less per frame (BENCHMARKS.md, packets).
     options.use_embree = false;
+    Look look;
+    look.shadows = request.shadows;
+    look.ao_samples = request.ao_samples;
+    // octiso-render's deferred path for a look (render_main.cpp): the tile loop writes only the
+    // AOVs, and the LookShader colours the frame from them with the light kit.
+    if (look.active()) options.want_colour = false, options.want_depth = options.want_normal = true;
     std::unique_ptr<Renderer>& renderer = renderers_[request.step];
-    if (!renderer) renderer = std::make_unique<Renderer>(AnyOctree::step(file_, request.step).make_renderer(options));
+    const auto make_tree = [&] { return AnyOctree::step(file_, request.step); };
+    if (!renderer) renderer = std::make_unique<Renderer>(make_tree().make_renderer(options));
     else renderer->set_options(options);   // validates the isovalue against the file's iso-range
+    if (look.active() && !(look_.shader && look_.step == request.step && look_.stored_iso == options.isovalues[0] &&
+                           look_.shadows == look.shadows && look_.ao_samples == look.ao_samples)) {
+        look_.shader.reset();
+        look_.shader.emplace(make_tree(), options, look, ShadingModel::kit);
+        look_.step = request.step, look_.stored_iso = options.isovalues[0];
+        look_.shadows = look.shadows, look_.ao_samples = look.ao_samples;
+    }
     FrameReply reply;
     reply.camera = camera_for(request);
     reply.stats = renderer->render(reply.camera, frame_);
+    if (look.active()) reply.look = look_.shader->shade(reply.camera, Shading{}, frame_);
     const auto t0 = std::chrono::steady_clock::now();
     if (request.encoding == FrameEncoding::rgba) {
         reply.body = rgba_bytes(frame_);
@@ -175,7 +197,7 @@ FrameReply ViewSession::render(const FrameRequest& request) {
         reply.content_type = "image/png";
     }
     reply.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    reply.command = render_command(path_, reply.camera, request.iso, request.step, step_count());
+    reply.command = render_command(path_, reply.camera, request.iso, look, request.step, step_count());
     return reply;
 }
 

@@ -16,6 +16,7 @@
 #include "octiso/any_octree.h"
 #include "octiso/camera.h"
 #include "octiso/frame.h"
+#include "octiso/look.h"
 #include "octiso/oct_file.h"
 #include "view/request.h"
 
@@ -26,7 +27,8 @@ struct FrameReply {
     std::string body;                  ///< the pixels in the request's encoding (request.h)
     std::string content_type;          ///< image/png, or application/octet-stream for rgba
     Camera camera;
-    RenderStats stats;
+    RenderStats stats;                 ///< the primary rays' tile loop
+    LookStats look;                    ///< shadow and AO rays and the kit's shading; zero when both are off
     double encode_seconds = 0;
     std::string command;   ///< octiso-render ... reproducing these pixels exactly (shell-quoted)
 };
@@ -45,7 +47,10 @@ public:
     ViewSession(const std::string& path, int threads, std::optional<double> initial_iso = {});
 
     /// Renders `request` (its step's Renderer made on first use). Not thread-safe: callers
-    /// serialise (the Coalescer does). request.iso is a real value. Throws Error("iso", ...) for an
+    /// serialise (the Coalescer does). request.iso is a real value. Without shadows and AO the
+    /// frame is the Renderer's own colour (octiso-render --shading headlight); with either, the
+    /// depth and normal AOVs shaded by a LookShader with the light kit (octiso-render --shadows,
+    /// --ao N), as octiso-render does for one sample per pixel. Throws Error("iso", ...) for an
     /// isovalue the file cannot render (outside its iso-range, named in real values).
     FrameReply render(const FrameRequest& request);
 
@@ -66,6 +71,15 @@ private:
     std::shared_ptr<const OctFile> file_;
     ValueScale scale_;                                   // the file's stored-to-real values
     std::vector<std::unique_ptr<Renderer>> renderers_;   // per step, null until first used
+    // The look of the last frame that had one, kept while its step, isovalue and look stay (a
+    // LookShader holds the isovalues it was made with); remade when one of them changes.
+    struct LookCache {
+        uint32_t step = 0;
+        double stored_iso = 0;
+        bool shadows = false;
+        int ao_samples = 0;
+        std::optional<LookShader> shader;
+    } look_;
     Frame frame_;                                        // reused: buffers kept between frames
     Histogram histogram_;
     std::string info_json_;
@@ -76,9 +90,11 @@ private:
 /// the page draws no histogram).
 Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_bytes);
 
-/// The octiso-render command line for `camera` and the real isovalue `iso` on `path` (step `step`
-/// of a file of `step_count` steps): numbers in the shortest form that reads back to the same
-/// double, so octiso-render converts the same real value to the same stored one.
-std::string render_command(const std::string& path, const Camera& camera, double iso, uint32_t step, uint32_t step_count);
+/// The octiso-render command line for `camera`, the real isovalue `iso` and `look` (shadows and
+/// ao_samples only; the rest at octiso-render's defaults) on `path` (step `step` of a file of
+/// `step_count` steps): numbers in the shortest form that reads back to the same double, so
+/// octiso-render converts the same real value to the same stored one.
+std::string render_command(const std::string& path, const Camera& camera, double iso, const Look& look, uint32_t step,
+                           uint32_t step_count);
 
 }  // namespace octiso::view

@@ -6,7 +6,9 @@ with the keyboard and orbits with a mouse drag on the image, waits for the full 
 input, and checks that the frame the page shows is, pixel for pixel, the image octiso-render
 writes for the command the page offers ("copy command"): the raw RGBA frame the page received on
 loopback, then the same view asked again as PNG (the encoding used from another host; decoded by
-a small decoder below), and each time the page's canvas read back as it is on screen.
+a small decoder below), and each time the page's canvas read back as it is on screen. Then the
+shadows toggle, once: the settled frame (the light kit with shadow rays) must equal octiso-render's
+image for the command the page then offers, which carries --shadows.
 
     tests/view/e2e_view.py TOOLS_DIR
 
@@ -198,12 +200,22 @@ def main():
             return window.octiso.lastFrame.seq;""")
         wait.until(lambda d: settled(d) and d.execute_script("return window.octiso.lastFrame.seq") > seq)
         check(shown_frame(), "png", ref)
+        # Shadows: one click on the toggle; the full frame that settles is the light kit with
+        # shadow rays, and the offered command (with --shadows) must write exactly those pixels.
+        seq = driver.execute_script("window.octiso.encoding = 'rgba'; return window.octiso.lastFrame.seq;")
+        driver.find_element(By.ID, "shadows").click()
+        wait.until(lambda d: settled(d) and d.execute_script("return window.octiso.lastFrame.seq") > seq)
+        shadowed = shown_frame()
+        assert " --shadows " in shadowed["command"] and "--shading" not in shadowed["command"], shadowed["command"]
+        shadow_ref = check(shadowed, "rgba")
+        assert shadow_ref[3] != ref[3], "the shadows toggle did not change the frame"
         command, ref_w, ref_h, ref = ref
         background = ref[0:3]
         hit = sum(1 for i in range(0, len(ref), 3) if ref[i:i + 3] != background)
         assert hit > ref_w * ref_h // 20, f"only {hit} pixels show the surface: a trivial frame proves little"
         print(f"e2e_view: {ref_w}x{ref_h} frame at iso {iso_after} after an orbit equals octiso-render's "
               f"({hit} surface pixels): {command}")
+        print(f"e2e_view: with shadows too: {shadow_ref[0]}")
         return 0
     finally:
         if driver is not None:

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "octiso/error.h"
 #include "view/request.h"
@@ -40,6 +41,35 @@ TEST(ViewRequest, ParsesTheRequiredParametersAndDefaultsTheRest) {
     EXPECT_EQ(r.step, 0u);
     EXPECT_EQ(r.seq, 0u);
     EXPECT_EQ(r.encoding, FrameEncoding::png);
+    EXPECT_FALSE(r.shadows);
+    EXPECT_EQ(r.ao_samples, 0);
+}
+
+TEST(ViewRequest, ShadowsAreZeroOrOneAndAoIsBounded) {
+    EXPECT_TRUE(parse_frame_request(with(base(), "shadows", "1"), 1).shadows);
+    EXPECT_FALSE(parse_frame_request(with(base(), "shadows", "0"), 1).shadows);
+    for (const std::string bad : {"", "true", "on", "yes", "01", "2", "-1", "1 ", " 1", "1.0", "+1"})
+        EXPECT_EQ(refusal(with(base(), "shadows", bad)), "shadows") << "'" << bad << "'";
+    EXPECT_EQ(parse_frame_request(with(base(), "ao", "8"), 1).ao_samples, 8);
+    EXPECT_EQ(parse_frame_request(with(base(), "ao", "0"), 1).ao_samples, 0);
+    EXPECT_EQ(parse_frame_request(with(base(), "ao", std::to_string(kMaxViewAoSamples)), 1).ao_samples, kMaxViewAoSamples);
+    const std::vector<std::string> bad_ao = {"", "-1", std::to_string(kMaxViewAoSamples + 1), "256", "8.0", "1e1", "+8", " 8", "8 ",
+                                             "0x8", "99999999999999999999"};
+    for (const std::string& bad : bad_ao)
+        EXPECT_EQ(refusal(with(base(), "ao", bad)), "ao") << "'" << bad << "'";
+    QueryParameters twice = with(base(), "shadows", "1");
+    twice.emplace_back("shadows", "1");
+    EXPECT_EQ(refusal(twice), "shadows");
+    QueryParameters ao_twice = with(base(), "ao", "8");
+    ao_twice.emplace_back("ao", "0");
+    EXPECT_EQ(refusal(ao_twice), "ao");
+    // Every parameter the page can send, at once, stays within the parameter bound.
+    QueryParameters all = base();
+    for (const auto& [n, v] : QueryParameters{{"zoom", "2"}, {"step", "0"}, {"seq", "3"}, {"enc", "rgba"}, {"shadows", "1"}, {"ao", "8"}})
+        all.emplace_back(n, v);
+    const FrameRequest r = parse_frame_request(all, 1);
+    EXPECT_TRUE(r.shadows);
+    EXPECT_EQ(r.ao_samples, 8);
 }
 
 TEST(ViewRequest, EncodingIsPngOrRgba) {

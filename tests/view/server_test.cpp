@@ -16,6 +16,8 @@
 #include "octiso/any_octree.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
+#include "octiso/look.h"
+#include "octiso/shading.h"
 #include "octiso/oct_file.h"
 #include "octiso/synthetic.h"
 #include "test_util/run_shell.h"
@@ -31,10 +33,11 @@ namespace {
 /// A served sphere:24 file (one step), or one converted with an iso-range.
 class ViewServerTest : public ::testing::Test {
 protected:
-    void start(const ServerOptions& base = {}, std::optional<std::array<double, 2>> iso_range = {}) {
+    void start(const ServerOptions& base = {}, std::optional<std::array<double, 2>> iso_range = {},
+               const std::string& synthetic = "sphere:24") {
         BuildOptions build;
         build.iso_range = iso_range;
-        AnyOctree::build(make_synthetic(parse_synthetic("sphere:24")), build).save(path_);
+        AnyOctree::build(make_synthetic(parse_synthetic(synthetic)), build).save(path_);
         session_ = std::make_unique<ViewSession>(path_, 2);
         ServerOptions options = base;
         options.port = 0;
@@ -268,6 +271,87 @@ TEST_F(ViewServerTest, SeriesStepFrameAndItsCommandReproduceThatStep) {
     size_t differing = 0;
     for (size_t i = 0; i < expected.rgb.size(); ++i) differing += std::lround(written.pixels[i] * 255.0f) != expected.rgb[i];
     EXPECT_EQ(differing, 0u);
+}
+
+/// Runs `command` (an offered octiso-render line ending in " -o frame.png") with the tools' binary
+/// and the output in `out`; returns the pixels it wrote as 8-bit RGB.
+std::vector<uint8_t> run_offered(const std::string& command, const std::string& path, const std::string& out) {
+    const std::string prefix = "octiso-render " + path + " ", tail = " -o frame.png";
+    EXPECT_EQ(command.rfind(prefix, 0), 0u) << command;
+    EXPECT_EQ(command.substr(command.size() - tail.size()), tail) << command;
+    const std::string flags = command.substr(prefix.size(), command.size() - prefix.size() - tail.size());
+    const std::string line = "'" + std::string(OCTISO_TOOLS_DIR) + "/octiso-render' '" + path + "' " + flags + " -o '" + out + "' 2>/dev/null";
+    EXPECT_EQ(test::run_shell(line), 0) << line;
+    const FloatImage written = read_image(out);
+    std::vector<uint8_t> rgb(written.pixels.size());
+    for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = uint8_t(std::lround(written.pixels[i] * 255.0f));
+    return rgb;
+}
+
+// Shadows and AO (issue 20 after issue 17 item 7): the frame is the light kit through LookShader
+// over the Renderer's AOVs, as octiso-render --shadows --ao N renders it, and the offered command
+// (which carries those flags) writes the same pixels. Marschner-Lobb's lobes cast shadows on each
+// other, so the shadows visibly change the frame.
+TEST_F(ViewServerTest, ShadowsAndAoFrameIsTheLookShadersAndItsCommandReproducesIt) {
+    if (!std::filesystem::exists(std::string(OCTISO_TOOLS_DIR) + "/octiso-render")) {
+        OCTISO_SKIP("octiso-render not built");
+    }
+    start({}, {}, "marschner-lobb:32");
+    const AnyOctree tree = AnyOctree::open(path_);
+    const Camera camera = orbit_camera(tree.dims(), tree.placement(), 48, 40, 30, 35, 1.3);
+    RenderOptions options;
+    options.isovalues = {0.5};
+    options.want_colour = false, options.want_depth = options.want_normal = true;
+    const auto look_frame = [&](bool shadows, int ao) {
+        Frame f = tree.render(camera, options);
+        Look look;
+        look.shadows = shadows, look.ao_samples = ao;
+        if (look.active()) LookShader(tree, options, look, ShadingModel::kit).shade(camera, Shading{}, f);
+        else shade_frame(tree, options.isovalues, camera, Shading{}, f);   // the kit without secondary rays
+        return f;
+    };
+    const Frame kit = look_frame(false, 0);
+    for (const auto& [shadows, ao] : {std::pair{true, 0}, {false, 8}, {true, 8}}) {
+        const std::string what = std::string(shadows ? "shadows" : "") + (ao ? " ao " + std::to_string(ao) : "");
+        auto res = get("/frame?iso=0.5&az=30&el=35&zoom=1.3&w=48&h=40&shadows=" + std::string(shadows ? "1" : "0") +
+                       "&ao=" + std::to_string(ao));
+        ASSERT_TRUE(res) << what;
+        ASSERT_EQ(res->status, 200) << what << ": " << res->body;
+        const Frame expected = look_frame(shadows, ao);
+        EXPECT_GT(expected.stats.hits, 200u) << what;
+        EXPECT_EQ(res->body, encode_png(expected)) << what << ": the LookShader's pixels";
+        EXPECT_NE(expected.rgb, kit.rgb) << what << ": the look must change the frame for this test to mean anything";
+        const std::string stats = res->get_header_value("X-Octiso-Stats");
+        EXPECT_EQ(stats.find(";secondary=0"), std::string::npos) << what << ": " << stats;
+
+        const std::string command = res->get_header_value("X-Octiso-Command");
+        EXPECT_EQ(command.find("--shading"), std::string::npos) << what << ": the kit is octiso-render's default: " << command;
+        EXPECT_EQ(command.find(" --shadows ") != std::string::npos, shadows) << command;
+        EXPECT_EQ(command.find(" --ao 8 ") != std::string::npos, ao == 8) << command;
+        const std::vector<uint8_t> written = run_offered(command, path_, dir_.file("look.png"));
+        ASSERT_EQ(written.size(), expected.rgb.size()) << what;
+        size_t differing = 0;
+        for (size_t i = 0; i < written.size(); ++i) differing += written[i] != expected.rgb[i];
+        EXPECT_EQ(differing, 0u) << what << ": " << command;
+    }
+    // Another isovalue with the same look: the session's LookShader (made for 0.5) is remade.
+    auto other = get("/frame?iso=0.4&az=30&el=35&zoom=1.3&w=48&h=40&shadows=1&ao=8");
+    ASSERT_TRUE(other);
+    options.isovalues = {0.4};
+    EXPECT_EQ(other->body, encode_png(look_frame(true, 8)));
+    options.isovalues = {0.5};
+    // Both off again: back to the Renderer's own colour and --shading headlight.
+    auto plain = get("/frame?iso=0.5&az=30&el=35&zoom=1.3&w=48&h=40&shadows=0&ao=0");
+    ASSERT_TRUE(plain);
+    RenderOptions headlight;
+    headlight.isovalues = {0.5};
+    EXPECT_EQ(plain->body, encode_png(tree.render(camera, headlight)));
+    EXPECT_NE(plain->get_header_value("X-Octiso-Command").find(" --shading headlight "), std::string::npos);
+    EXPECT_NE(plain->get_header_value("X-Octiso-Stats").find(";look=0.000000;secondary=0"), std::string::npos);
+    auto bad = get("/frame?iso=0.5&az=30&el=35&w=8&h=8&ao=17");
+    ASSERT_TRUE(bad);
+    EXPECT_EQ(bad->status, 400);
+    EXPECT_EQ(bad->body, "ao: out of range (expected 0..16, found 17)\n");
 }
 
 TEST_F(ViewServerTest, RequestsBeyondTheRateBoundAreRefused) {
