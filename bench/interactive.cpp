@@ -34,13 +34,15 @@ namespace {
 
 const char* const kInteractiveUsage =
     "usage: octiso-bench interactive [--datasets SPEC,...] [--sizes 512,1024] [--changes N] [--threads N]\n"
-    "                                [--no-mesh] [--quick]\n"
+    "                                [--no-mesh] [--quick] [--shadows] [--ao N]\n"
     "  SPEC: a volume file (default /usr/share/mricron/templates/ch2better.nii.gz) or NAME:N (synthetic);\n"
     "  default datasets ch2better and marschner-lobb:256 (--quick: marschner-lobb:64 for the synthetic);\n"
     "  --changes isovalue changes per size (default 60, --quick 4), --threads render threads (default 2);\n"
     "  mesh: median of 3 isovalues (--quick: 1).\n"
     "  Latency: GET /frame sent -> RGBA frame received (the page's loopback format), p50 and p95; mesh: extraction + BVH per change;\n"
-    "  orbit: --changes azimuth steps at a third of the side (the page's drag frames), frames/s back to back.";
+    "  orbit: --changes azimuth steps at a third of the side (the page's drag frames), frames/s back to back;\n"
+    "  --shadows, --ao N: every frame with the page's look toggles (the light kit with shadow / N AO rays per hit;\n"
+    "  the orbit's drag frames skip AO, as the page's do).";
 
 #ifdef OCTISO_HAVE_VIEW
 
@@ -75,7 +77,8 @@ int run_interactive(cli::Args& args) {
         std::cout << kInteractiveUsage << "\n";
         return 0;
     }
-    const bool quick = args.flag("--quick"), no_mesh = args.flag("--no-mesh");
+    const bool quick = args.flag("--quick"), no_mesh = args.flag("--no-mesh"), shadows = args.flag("--shadows");
+    const auto ao_flag = args.value("--ao");
     const auto datasets_flag = args.value("--datasets"), sizes_flag = args.value("--sizes");
     const auto changes_flag = args.value("--changes"), threads_flag = args.value("--threads");
     const std::string results = results_dir(args);
@@ -97,6 +100,10 @@ int run_interactive(cli::Args& args) {
     }
     const int changes = changes_flag ? int(cli::parse_int(*changes_flag, "--changes", 2, 100000)) : quick ? 4 : 60;
     const int threads = threads_flag ? int(cli::parse_int(*threads_flag, "--threads", 1, 1024)) : 2;
+    const int ao = ao_flag ? int(cli::parse_int(*ao_flag, "--ao", 0, view::kMaxViewAoSamples)) : 0;
+    // The look of every frame as the page asks for it (request.h); drag frames never carry AO.
+    const std::string look = std::string(shadows ? "&shadows=1" : "") + (ao > 0 ? "&ao=" + std::to_string(ao) : "");
+    const std::string drag_look = shadows ? "&shadows=1" : "";
 
     std::vector<Row> rows;
     Table table({"dataset", "image", "changes", "p50 ms", "p95 ms", "max ms", "render p50 ms", "mesh extract ms", "mesh BVH ms",
@@ -143,8 +150,8 @@ int run_interactive(cli::Args& args) {
                 std::vector<double> latency, render;
                 for (int i = -2; i < changes; ++i) {   // two warm-up frames build the Renderer
                     char target[256];
-                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d&enc=rgba", iso_of(i + 2),
-                                  kDefaultAzimuthDeg, kDefaultElevationDeg, side, side, i + 3);
+                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d&enc=rgba%s", iso_of(i + 2),
+                                  kDefaultAzimuthDeg, kDefaultElevationDeg, side, side, i + 3, look.c_str());
                     const auto t0 = std::chrono::steady_clock::now();
                     auto res = client.Get(target);
                     if (!res || res->status != 200)
@@ -155,7 +162,8 @@ int run_interactive(cli::Args& args) {
                     if (i < 0) continue;
                     latency.push_back(ms);
                     const std::string stats = res->get_header_value("X-Octiso-Stats");
-                    render.push_back(std::stod(stats.substr(stats.find("seconds=") + 8)) * 1e3);
+                    // The frame's render: the tile loop plus the look's pass (0 without toggles).
+                    render.push_back((std::stod(stats.substr(stats.find("seconds=") + 8)) + std::stod(stats.substr(stats.find(";look=") + 6))) * 1e3);
                     const size_t h = stats.find("hits=");
                     row.hits_last = std::stoull(stats.substr(h + 5));
                 }
@@ -166,8 +174,9 @@ int run_interactive(cli::Args& args) {
                 const auto orbit_start = std::chrono::steady_clock::now();
                 for (int i = 0; i < changes; ++i) {
                     char target[256];
-                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d&enc=rgba", iso_of(0),
-                                  kDefaultAzimuthDeg + 2.0 * (i + 1), kDefaultElevationDeg, row.preview_side, row.preview_side, i);
+                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d&enc=rgba%s", iso_of(0),
+                                  kDefaultAzimuthDeg + 2.0 * (i + 1), kDefaultElevationDeg, row.preview_side, row.preview_side, i,
+                                  drag_look.c_str());
                     const auto t0 = std::chrono::steady_clock::now();
                     auto res = client.Get(target);
                     if (!res || res->status != 200) throw Error(name, "viewer refused an orbit frame", ErrorKind::Other);
@@ -210,12 +219,13 @@ int run_interactive(cli::Args& args) {
         if (std::fscanf(f, "%lf", &load) != 1) load = -1;
         std::fclose(f);
     }
-    std::cout << "isovalue change -> RGBA frame received, octiso-view over loopback, " << threads << " render thread(s) ("
+    std::cout << "isovalue change -> RGBA frame received, octiso-view over loopback, " << threads << " render thread(s)"
+              << (look.empty() ? "" : ", look" + std::string(shadows ? " shadows" : "") + (ao > 0 ? " ao " + std::to_string(ao) : "")) << " ("
               << machine_description() << "; load average " << fmt(load, 2) << ")\n";
     table.print(std::cout);
     const std::string path = write_json(results, "interactive", [&](cli::JsonWriter& j) {
         j.field("threads", int64_t(threads)).field("changes", int64_t(changes)).field("machine", machine_description());
-        j.field("load_average_1min", load);
+        j.field("load_average_1min", load).field("shadows", shadows).field("ao", int64_t(ao));
         j.key("rows").begin_array();
         for (const Row& r : rows) {
             j.begin_object().field("dataset", r.dataset).field("image", int64_t(r.side)).field("p50_ms", r.p50_ms);
