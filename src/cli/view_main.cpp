@@ -20,7 +20,8 @@ namespace {
 const char* kUsage =
     "usage: octiso-view FILE.oct [--port P] [--host H] [--threads N] [--iso V]\n"
     "  serves an interactive viewer of FILE.oct at http://H:P/ (default 127.0.0.1:8080; --port 0 picks a free port);\n"
-    "  --iso: the isovalue the page starts at (default: the middle of the data's range)";
+    "  --iso: the isovalue the page starts at (default: the middle of the data's range); like every value\n"
+    "  on the page a real value (a scaled NIfTI's stored * scl_slope + scl_inter, as octiso-render --iso)";
 
 int run(std::vector<std::string>& argv) {
     for (const std::string& a : argv)   // --help wins over every other argument
