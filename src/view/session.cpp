@@ -11,8 +11,8 @@
 
 #include "octiso/error.h"
 #include "octiso/look.h"
-#include "octiso/shading.h"
 #include "octiso/render.h"
+#include "octiso/shading.h"
 #include "octiso/volume.h"
 #include "view/png.h"
 #include "view/rgba.h"
