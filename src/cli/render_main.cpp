@@ -2,10 +2,12 @@
 // time step with --steps A:B (names then hold one printf integer field, e.g. frame_%04d.png).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <optional>
 
 #include "cli/common/cli.h"
@@ -13,7 +15,10 @@
 #include "cli/common/output_path.h"
 #include "cli/common/report.h"
 #include "cli/render_camera.h"
+#include "cli/render_ranks.h"
 #include "octiso/antialias.h"
+#include "octiso/bricks.h"
+#include "octiso/depth_composite.h"
 #include "octiso/shading.h"
 #include "octiso/any_octree.h"
 #include "octiso/debug_trace.h"
@@ -89,14 +94,15 @@ private:
     std::chrono::steady_clock::time_point start_;
 };
 
-int run(std::vector<std::string>& argv) {
+int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
+    using cli::Distribute, cli::FrameRecord, cli::RankExchange;
     cli::Args args(argv);
     if (args.flag("--help") || args.flag("-h")) {
-        std::cout << kUsage;
+        if (ranks.rank == 0) std::cout << kUsage;
         return 0;
     }
     if (argv.empty()) {   // the same in every tool: the help, as a usage error
-        std::cerr << kUsage;
+        if (ranks.rank == 0) std::cerr << kUsage;
         return 2;
     }
     const auto iso_text = args.value("--iso");
@@ -111,11 +117,16 @@ int run(std::vector<std::string>& argv) {
     const bool no_embree = args.flag("--no-embree"), json = args.flag("--json");
     const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
+    const auto distribute_text = args.value("--distribute");
     const std::vector<std::string> inputs = args.positional();
     args.finish();
     if (inputs.size() != 1) throw Error("octiso-render", "expected exactly one FILE.oct (octiso-render --help lists every flag)");
     if (!iso_text) throw Error("--iso", "is required (one or more isovalues, e.g. --iso 40,120)");
     if (!out_path && !depth_path && !normal_path && !debug_pixel) throw Error("-o", "is required (or at least --depth or --normal)");
+
+    const Distribute distribute = distribute_text ? cli::parse_distribute(*distribute_text) : Distribute::steps;
+    if (distribute_text && !ranks.mpi_built())
+        throw Error("--distribute", "this octiso-render was built without MPI (install libopenmpi-dev and rebuild)");
 
     RenderOptions options;
     options.isovalues = cli::parse_list(*iso_text, "--iso");
@@ -174,7 +185,7 @@ int run(std::vector<std::string>& argv) {
         // never a file literally named frame_%02d.png).
         series = true;
         last = (long long)info.step_count - 1;
-    } else if (info.step_count > 1 && !debug_pixel) {
+    } else if (info.step_count > 1 && !debug_pixel && ranks.rank == 0) {
         std::fprintf(stderr, "octiso-render: note: %s has %u steps; rendering step %lld (--steps A:B, or a %%04d field in -o, renders more)\n",
                      inputs[0].c_str(), info.step_count, first);
     }
@@ -230,15 +241,124 @@ int run(std::vector<std::string>& argv) {
         if (comma == std::string::npos) throw Error("--debug-pixel", "expected X,Y, found '" + *debug_pixel + "'");
         const int x = int(cli::parse_int(debug_pixel->substr(0, comma), "--debug-pixel", INT32_MIN, INT32_MAX));
         const int y = int(cli::parse_int(debug_pixel->substr(comma + 1), "--debug-pixel", INT32_MIN, INT32_MAX));
-        std::cout << AnyOctree::step(file, uint32_t(first)).trace_pixel(cameras[0], trace_options, x, y).text();
+        if (ranks.rank == 0) std::cout << AnyOctree::step(file, uint32_t(first)).trace_pixel(cameras[0], trace_options, x, y).text();
         return 0;
     }
+
+    // ---- Distribution over MPI ranks (issue 15; one rank, the default, is the serial tool) ----
+    const int rank = ranks.rank, rank_count = ranks.size;
+    const bool root = rank == 0;
+    const bool split_frames = distribute != Distribute::steps && rank_count > 1;
+    RenderOptions rank_options = trace_options;
+    CompositeLayout layout;
+    if (distribute == Distribute::data) {
+        // Each rank traces its slab of cells (octiso/bricks.h) and the frames are composited by
+        // depth, which needs the depth of every sample whatever is written.
+        rank_options.want_depth = true;
+        rank_options.owned_cells = slab_bricks(info.dims, rank_count)[size_t(rank)];
+        layout = CompositeLayout{rank_options.want_colour || deferred, normal_path.has_value()};
+    }
+    // Every rank got this far (or a lower one reports why not): from here a failure aborts all.
+    if (const int failed = ranks.agree_ready(0)) return failed;
 
     cli::JsonWriter j(std::cout);
     const auto camera_json = [&](const Camera& c) {
         j.begin_object().key("eye").array(c.eye).key("look").array(c.look).key("up").array(c.up);
         j.field("fov", c.fov_deg).field("width", c.width).field("height", c.height).end_object();
     };
+    Progress progress(root && !split_frames && rank_count == 1 ? (long long)jobs.size() : 0);
+    std::optional<Renderer> renderer;
+    std::optional<AnyOctree> step_tree;
+    long long renderer_step = -1;
+    std::vector<FrameRecord> records;   // this rank's frames
+    const auto wall_start = std::chrono::steady_clock::now();
+    const auto render_job = [&](size_t n) {
+        const Job& job = jobs[n];
+        // One Renderer per step, kept across the frames of an orbit; the Embree device behind it
+        // is shared by the whole process.
+        if (job.step != renderer_step) {
+            renderer.reset();
+            step_tree.emplace(AnyOctree::step(file, uint32_t(job.step)));
+            renderer.emplace(step_tree->make_renderer(rank_options));
+            renderer_step = job.step;
+        }
+        FrameRecord record{job.index, job.step, rank};
+        // One sample: traced by this rank (its tiles or its brick when frames are split), shaded
+        // here (deferred shading reads only the pixel's own hit), then assembled on rank 0.
+        const auto render_sample = [&](const Camera& c, Frame& f) {
+            RenderStats stats;
+            if (split_frames && distribute == Distribute::image) {
+                renderer->prepare_frame(c, f);
+                // Pixels of other ranks' tiles are misses here, so shading them costs nothing.
+                std::fill(f.depth.begin(), f.depth.end(), std::numeric_limits<float>::infinity());
+                std::fill(f.normal.begin(), f.normal.end(), 0.0f);
+                const TileGrid grid = renderer->tile_grid(c.width, c.height);
+                stats = renderer->render_tiles(c, ranks.tiles_of(grid.count()), f);
+            } else {
+                stats = renderer->render(c, f);
+            }
+            if (deferred) shade_frame(*step_tree, options.isovalues, c, shading, f);
+            if (split_frames) {
+                const RankExchange cost = distribute == Distribute::image
+                                              ? ranks.gather_tiles(renderer->tile_grid(c.width, c.height), out_path.has_value(),
+                                                                   depth_path.has_value(), normal_path.has_value(), f)
+                                              : ranks.composite(layout, f);
+                record.exchange_seconds += cost.seconds;
+                record.bytes_sent += cost.bytes_sent;
+            } else if (distribute == Distribute::data) {
+                ranks.composite(layout, f);   // one rank: the brick is the volume; unpack is exact
+            }
+            record.rays += stats.rays;
+            record.seconds += stats.seconds;
+            record.threads = stats.threads;
+            return stats;
+        };
+        Frame frame;
+        const auto t0 = std::chrono::steady_clock::now();
+        render_antialiased(SampleRenderer(render_sample), *job.camera, spp, frame);
+        // The whole frame: every sample traced and shaded (record.seconds: the tile loops only).
+        record.frame_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        record.hits = frame.stats.hits;
+        file->check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
+        if (root || !split_frames) {
+            if (out_path) write_colour_image(name_for(out_path, "-o", job.index), frame);
+            if (depth_path) write_depth_image(name_for(depth_path, "--depth", job.index), frame);
+            if (normal_path) write_normal_image(name_for(normal_path, "--normal", job.index), frame);
+            record.wrote = true;
+        }
+        // The effective camera, as flags that reproduce it (issue 17: a view can be pasted back);
+        // after the first image is written, so that a failure stays one line on stderr.
+        if (root && records.empty())
+            std::fprintf(stderr, "camera: %s%s\n", cli::camera_flags_text(cameras[0]).c_str(),
+                         orbit ? (" (first of " + std::to_string(cameras.size()) + " orbit frames)").c_str() : "");
+        if ((root || !split_frames) && (!series || !::isatty(2)))
+            std::fprintf(stderr, "%s%s%s: %dx%d in %.3f s (%.2f Mrays/s, %llu hits, %d threads%s)%s\n",
+                         rank_count > 1 && !split_frames ? ("rank " + std::to_string(rank) + ": ").c_str() : "",
+                         series ? ((orbit ? "frame " : "step ") + std::to_string(job.index) + " ").c_str() : "",
+                         out_path ? name_for(out_path, "-o", job.index).c_str() : "frame", frame.width, frame.height,
+                         record.seconds, record.seconds > 0 ? double(record.rays) / record.seconds * 1e-6 : 0.0,
+                         (unsigned long long)record.hits, record.threads,
+                         spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
+                         orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
+        records.push_back(record);
+        progress.update((long long)records.size());
+    };
+    if (!split_frames && rank_count > 1) {
+        // Series across ranks: rank 0 deals the jobs one at a time to whichever rank is free.
+        ranks.deal(jobs.size(), render_job);
+    } else {
+        for (size_t n = 0; n < jobs.size(); ++n) render_job(n);
+    }
+    const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    // Rank 0 learns every rank's frames: all of them (steps), or each rank's share of each frame.
+    const std::vector<FrameRecord> all = ranks.gather_records(records, wall_seconds);
+    if (!root) return 0;
+    std::vector<FrameRecord> frames;   // one per image, in index order, rank 0's share when split
+    for (const FrameRecord& r : all)
+        if (r.wrote) frames.push_back(r);
+    std::sort(frames.begin(), frames.end(), [](const FrameRecord& a, const FrameRecord& b) { return a.index < b.index; });
+    double total_seconds = 0;
+    for (const FrameRecord& r : all) total_seconds += r.seconds;
     if (json) {
         j.begin_object().field("file", inputs[0]).field("type", std::string(scalar_type_name(info.type)));
         j.key("isovalues").array(options.isovalues);
@@ -247,71 +367,74 @@ int run(std::vector<std::string>& argv) {
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
+        j.field("ranks", rank_count).field("distribute", std::string(distribute_name(distribute)));
         j.key("camera");
         camera_json(cameras[0]);
         j.key("frames").begin_array();
-    }
-    Progress progress((long long)jobs.size());
-    double total_seconds = 0;
-    std::optional<Renderer> renderer;
-    std::optional<AnyOctree> step_tree;
-    long long renderer_step = -1;
-    for (size_t n = 0; n < jobs.size(); ++n) {
-        const Job& job = jobs[n];
-        // One Renderer per step, kept across the frames of an orbit; the Embree device behind it
-        // is shared by the whole process.
-        if (job.step != renderer_step) {
-            renderer.reset();
-            step_tree.emplace(AnyOctree::step(file, uint32_t(job.step)));
-            renderer.emplace(step_tree->make_renderer(trace_options));
-            renderer_step = job.step;
-        }
-        Frame frame;
-        const auto t0 = std::chrono::steady_clock::now();
-        render_antialiased(*renderer, *job.camera, spp, frame, deferred ? SampleShader([&](const Camera& c, Frame& f) {
-            shade_frame(*step_tree, options.isovalues, c, shading, f);
-        }) : SampleShader());
-        // The whole frame: every sample traced and shaded (frame.stats.seconds: the tile loops only).
-        const double frame_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        file->check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
-        if (out_path) write_colour_image(name_for(out_path, "-o", job.index), frame);
-        if (depth_path) write_depth_image(name_for(depth_path, "--depth", job.index), frame);
-        if (normal_path) write_normal_image(name_for(normal_path, "--normal", job.index), frame);
-        total_seconds += frame.stats.seconds;
-        // The effective camera, as flags that reproduce it (issue 17: a view can be pasted back);
-        // after the first image is written, so that a failure stays one line on stderr.
-        if (n == 0)
-            std::fprintf(stderr, "camera: %s%s\n", cli::camera_flags_text(cameras[0]).c_str(),
-                         orbit ? (" (first of " + std::to_string(cameras.size()) + " orbit frames)").c_str() : "");
-        if (json) {
-            j.begin_object().field("step", job.step);
-            if (orbit) j.field("frame", job.index);
-            j.field("seconds", frame.stats.seconds).field("frame_seconds", frame_seconds);
-            j.field("mrays_per_second", frame.stats.mrays_per_second()).field("rays", frame.stats.rays);
-            j.field("hits", frame.stats.hits).field("threads", frame.stats.threads);
-            if (out_path) j.field("image", name_for(out_path, "-o", job.index));
+        for (const FrameRecord& r : frames) {
+            j.begin_object().field("step", r.step);
+            if (orbit) j.field("frame", r.index);
+            j.field("seconds", r.seconds).field("frame_seconds", r.frame_seconds);
+            j.field("mrays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0.0).field("rays", r.rays);
+            j.field("hits", r.hits).field("threads", r.threads);
+            if (rank_count > 1) j.field("rank", r.rank);
+            if (out_path) j.field("image", name_for(out_path, "-o", r.index));
             j.key("camera");
-            camera_json(*job.camera);
+            camera_json(*jobs[size_t(r.index - jobs.front().index)].camera);
+            if (split_frames) {   // every rank's share of this frame
+                j.key("ranks").begin_array();
+                for (const FrameRecord& q : all)
+                    if (q.index == r.index)
+                        j.begin_object().field("rank", q.rank).field("seconds", q.seconds).field("rays", q.rays)
+                            .field("exchange_seconds", q.exchange_seconds).field("bytes_sent", q.bytes_sent).end_object();
+                j.end_array();
+            }
             j.end_object();
         }
-        if (!series || !::isatty(2))
-            std::fprintf(stderr, "%s%s: %dx%d in %.3f s (%.2f Mrays/s, %llu hits, %d threads%s)%s\n",
-                         series ? ((orbit ? "frame " : "step ") + std::to_string(job.index) + " ").c_str() : "",
-                         out_path ? name_for(out_path, "-o", job.index).c_str() : "frame", frame.width, frame.height,
-                         frame.stats.seconds, frame.stats.mrays_per_second(), (unsigned long long)frame.stats.hits,
-                         frame.stats.threads, spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
-                         orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
-        progress.update((long long)n + 1);
-    }
-    if (json) {
-        j.end_array().field("total_seconds", total_seconds).end_object();
+        j.end_array().field("total_seconds", total_seconds).field("wall_seconds", wall_seconds);
+        if (rank_count > 1) {   // per rank: its steps (or frame shares) and seconds
+            j.key("per_rank").begin_array();
+            for (int q = 0; q < rank_count; ++q) {
+                std::vector<long long> steps_done;
+                double seconds = 0, rank_wall = 0;
+                for (const FrameRecord& r : all)
+                    if (r.rank == q) steps_done.push_back(r.step), seconds += r.seconds, rank_wall = r.rank_wall_seconds;
+                j.begin_object().field("rank", q).field("frames", (long long)steps_done.size());
+                j.key("steps").array(steps_done);
+                j.field("seconds", seconds).field("wall_seconds", rank_wall).end_object();
+            }
+            j.end_array();
+        }
+        j.end_object();
         std::cout << "\n";
     }
-    if (series) std::fprintf(stderr, "%zu frames in %.3f s render time\n", jobs.size(), total_seconds);
+    if (series) std::fprintf(stderr, "%zu frames in %.3f s render time%s\n", frames.size(), total_seconds,
+                             rank_count > 1 ? (", " + cli::number(wall_seconds) + " s wall on " + std::to_string(rank_count) + " ranks").c_str() : "");
     return 0;
 }
 
 }  // namespace
 }  // namespace octiso
 
-int main(int argc, char** argv) { return octiso::cli::run_main("octiso-render", argc, argv, octiso::run); }
+int main(int argc, char** argv) {
+    std::optional<octiso::cli::Ranks> ranks;
+    try {
+        ranks.emplace(octiso::cli::Ranks::for_process(argc, argv));   // MPI_Init under mpirun
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "octiso-render: %s\n", e.what());
+        return 1;
+    }
+    // Under mpirun every rank prepares the same work; a failure is reported once, by the lowest
+    // rank that met it, and every rank exits with it (cli/render_ranks.h).
+    return octiso::cli::run_main("octiso-render", argc, argv, [&](std::vector<std::string>& args) {
+        try {
+            return octiso::run(args, *ranks);
+        } catch (const octiso::Error& e) {
+            if (ranks->should_report(e.exit_status(), e.what())) throw;
+            return e.exit_status();
+        } catch (const std::exception& e) {
+            if (ranks->should_report(1, e.what())) throw;
+            return 1;
+        }
+    });
+}

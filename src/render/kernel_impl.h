@@ -19,6 +19,7 @@ template <typename T> TracerKernel build_tracer_kernel(const Octree<T>& tree, co
         auto tracer = std::make_shared<Tracer>(tree, placement, options.isovalues.data(), int(options.isovalues.size()),
                                                finder);
         if (options.packet_min_lanes > 0) tracer->set_min_packet_lanes(options.packet_min_lanes);
+        if (options.owned_cells) tracer->set_owned_cells(*options.owned_cells);
         TracerKernel k;
         k.user = tracer.get();
         k.tracer = std::move(tracer);

@@ -83,6 +83,16 @@ public:
     /// against a frame in flight.
     void set_min_packet_lanes(int lanes) { min_packet_lanes_ = std::max(1, lanes); }
 
+    /// Sort-last (RenderOptions::owned_cells): only the cells of `box` are tested and subtrees
+    /// wholly outside it are skipped where min/max culling would skip them. The child intervals
+    /// are computed exactly as without the box, so a hit inside it is the whole volume's hit bit
+    /// for bit; cells are half-open along the ray, so a surface on a box face is claimed by the
+    /// box whose cell the ray enters there, once. Not thread-safe against a frame in flight.
+    void set_owned_cells(const CellBox& box) {
+        restricted_ = true;
+        owned_ = box;
+    }
+
     /// First hits of rays[0 .. count), count <= kMaxPacket; lanes with valid[k] == 0 (valid may be
     /// null: all valid) are misses. Every hit equals trace(rays[k]) bit for bit: each lane sees the
     /// same child intervals, culls and cell walks as alone (see packet_node). Thread-safe.
@@ -114,6 +124,19 @@ public:
     }
 
 private:
+    /// Whether the cube [o, o + side)^3 of cells meets the owned box.
+    bool overlaps_owned(const Coord& o, uint32_t side) const {
+        const uint32_t lo[3] = {o.x, o.y, o.z};
+        for (int a = 0; a < 3; ++a)
+            if (uint64_t(lo[a]) + side <= owned_.lo[a] || lo[a] >= owned_.hi[a]) return false;
+        return true;
+    }
+    bool owns_cell(const int64_t cell[3]) const {
+        for (int a = 0; a < 3; ++a)
+            if (cell[a] < int64_t(owned_.lo[a]) || cell[a] >= int64_t(owned_.hi[a])) return false;
+        return true;
+    }
+
     static Coord child_origin_of(const Coord& o, int c, uint32_t half) {
         return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
     }
@@ -151,6 +174,7 @@ private:
                                    t_next);
             if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) return false;
             const Coord co = child_origin_of(o, c, half);
+            if (restricted_ && !overlaps_owned(co, half)) return false;
             if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
             else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;
@@ -245,6 +269,7 @@ private:
             const unsigned entered = lanes_in[c] & active;
             if (!entered || !n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
             const Coord co = child_origin_of(o, int(c), half);
+            if (restricted_ && !overlaps_owned(co, half)) continue;
             unsigned hit = 0;
             if (n.is_scalar_leaf(int(c))) {
                 for (unsigned m = entered; m; m &= m - 1) {
@@ -362,6 +387,7 @@ private:
                               if (cell[0] > last_cell[0] || cell[1] > last_cell[1] || cell[2] > last_cell[2])
                                   return false;
                               OCTISO_DCHECK(cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0, "cell below the data box");
+                              if (restricted_ && !owns_cell(cell)) return false;   // a scalar leaf across the box face
                               const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
                               double corner[8];
                               gather(v, corner);
@@ -385,6 +411,8 @@ private:
     const CellWalkScene scene_;
     const Finder finder_;
     int min_packet_lanes_ = kDefaultMinPacketLanes;
+    bool restricted_ = false;   ///< set_owned_cells() was called
+    CellBox owned_;
     [[no_unique_address]] const Corners corners_;
     [[no_unique_address]] const Recorder recorder_;
 };
