@@ -9,6 +9,7 @@
 #include <iostream>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
@@ -16,6 +17,7 @@
 #include "cli/common/report.h"
 #include "cli/render_camera.h"
 #include "cli/render_ranks.h"
+#include "util/process_memory.h"
 #include "octiso/antialias.h"
 #include "octiso/bricks.h"
 #include "octiso/depth_composite.h"
@@ -251,15 +253,18 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     const bool split_frames = distribute != Distribute::steps && rank_count > 1;
     RenderOptions rank_options = trace_options;
     CompositeLayout layout;
+    const std::vector<CellBox> bricks = slab_bricks(info.dims, rank_count);
     if (distribute == Distribute::data) {
         // Each rank traces its slab of cells (octiso/bricks.h) and the frames are composited by
         // depth, which needs the depth of every sample whatever is written.
         rank_options.want_depth = true;
-        rank_options.owned_cells = slab_bricks(info.dims, rank_count)[size_t(rank)];
+        rank_options.owned_cells = bricks[size_t(rank)];
         layout = CompositeLayout{rank_options.want_colour || deferred, normal_path.has_value()};
     }
     // Every rank got this far (or a lower one reports why not): from here a failure aborts all.
     if (const int failed = ranks.agree_ready(0)) return failed;
+    // Sort-last: validation read the whole file; from here this rank holds only what its brick reads.
+    if (split_frames && distribute == Distribute::data) file->release_resident_pages();
 
     cli::JsonWriter j(std::cout);
     const auto camera_json = [&](const Camera& c) {
@@ -270,6 +275,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     std::optional<Renderer> renderer;
     std::optional<AnyOctree> step_tree;
     long long renderer_step = -1;
+    uint64_t ghost_bytes = 0;   // sent with the latest step's ghost exchange
     std::vector<FrameRecord> records;   // this rank's frames
     const auto wall_start = std::chrono::steady_clock::now();
     const auto render_job = [&](size_t n) {
@@ -279,10 +285,13 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         if (job.step != renderer_step) {
             renderer.reset();
             step_tree.emplace(AnyOctree::step(file, uint32_t(job.step)));
+            if (split_frames && distribute == Distribute::data)   // the voxels beyond the slab, from their owner
+                rank_options.ghost_plane = ranks.ghost_plane(bricks, [&](uint32_t x) { return step_tree->x_plane(x); }, ghost_bytes);
             renderer.emplace(step_tree->make_renderer(rank_options));
             renderer_step = job.step;
         }
         FrameRecord record{job.index, job.step, rank};
+        record.bytes_sent = std::exchange(ghost_bytes, 0);
         // One sample: traced by this rank (its tiles or its brick when frames are split), shaded
         // here (deferred shading reads only the pixel's own hit), then assembled on rank 0.
         const auto render_sample = [&](const Camera& c, Frame& f) {
@@ -351,7 +360,10 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     }
     const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     // Rank 0 learns every rank's frames: all of them (steps), or each rank's share of each frame.
-    const std::vector<FrameRecord> all = ranks.gather_records(records, wall_seconds);
+    // Sort-last: how much of the file this rank mapped (issue 15: its brick's pages and little
+    // else; /proc/self/smaps, the kernel's fault-around included).
+    const uint64_t resident = rank_count > 1 ? mapped_resident_bytes(inputs[0]) : 0;
+    const std::vector<FrameRecord> all = ranks.gather_records(records, wall_seconds, resident);
     if (!root) return 0;
     std::vector<FrameRecord> frames;   // one per image, in index order, rank 0's share when split
     for (const FrameRecord& r : all)
@@ -397,11 +409,19 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             for (int q = 0; q < rank_count; ++q) {
                 std::vector<long long> steps_done;
                 double seconds = 0, rank_wall = 0;
+                uint64_t rank_resident = 0;
                 for (const FrameRecord& r : all)
-                    if (r.rank == q) steps_done.push_back(r.step), seconds += r.seconds, rank_wall = r.rank_wall_seconds;
+                    if (r.rank == q)
+                        steps_done.push_back(r.step), seconds += r.seconds, rank_wall = r.rank_wall_seconds,
+                            rank_resident = r.file_resident_bytes;
                 j.begin_object().field("rank", q).field("frames", (long long)steps_done.size());
                 j.key("steps").array(steps_done);
-                j.field("seconds", seconds).field("wall_seconds", rank_wall).end_object();
+                j.field("seconds", seconds).field("wall_seconds", rank_wall).field("file_resident_bytes", rank_resident);
+                if (distribute == Distribute::data) {
+                    const CellBox& b = bricks[size_t(q)];
+                    j.key("brick").begin_object().key("lo").array(b.lo).key("hi").array(b.hi).end_object();
+                }
+                j.end_object();
             }
             j.end_array();
         }

@@ -9,6 +9,7 @@
 
 #if OCTISO_WITH_MPI
 #include "mpi/frame_exchange.h"
+#include "mpi/ghost_exchange.h"
 #include "mpi/step_dealer.h"
 #include "mpi/world.h"
 #endif
@@ -118,6 +119,16 @@ RankExchange Ranks::composite(const CompositeLayout& layout, Frame& frame) {
     return {};
 }
 
+std::shared_ptr<const std::vector<double>> Ranks::ghost_plane(
+    [[maybe_unused]] const std::vector<CellBox>& bricks,
+    [[maybe_unused]] const std::function<std::vector<double>(uint32_t)>& decode, uint64_t& bytes_sent) {
+    bytes_sent = 0;
+#if OCTISO_WITH_MPI
+    if (mpi_) return mpi::exchange_ghost_planes(mpi_->world, bricks, decode, bytes_sent);
+#endif
+    return nullptr;   // one rank: its brick is the volume
+}
+
 void Ranks::deal(size_t count, const std::function<void(size_t)>& render) {
 #if OCTISO_WITH_MPI
     if (mpi_) {
@@ -130,8 +141,9 @@ void Ranks::deal(size_t count, const std::function<void(size_t)>& render) {
     for (size_t n = 0; n < count; ++n) render(n);
 }
 
-std::vector<FrameRecord> Ranks::gather_records(std::vector<FrameRecord> mine, double wall_seconds) {
-    for (FrameRecord& r : mine) r.rank_wall_seconds = wall_seconds;
+std::vector<FrameRecord> Ranks::gather_records(std::vector<FrameRecord> mine, double wall_seconds,
+                                               uint64_t file_resident_bytes) {
+    for (FrameRecord& r : mine) r.rank_wall_seconds = wall_seconds, r.file_resident_bytes = file_resident_bytes;
 #if OCTISO_WITH_MPI
     if (mpi_ && size > 1) {
         // Fixed-size rows: first how many each rank has, then every rank padded to the most.

@@ -12,6 +12,7 @@
 #include "octiso/depth_composite.h"
 #include "octiso/frame.h"
 #include "octiso/tiles.h"
+#include "octiso/volume.h"
 
 namespace octiso::cli {
 
@@ -28,6 +29,7 @@ struct FrameRecord {
     int rank = 0;
     double seconds = 0, frame_seconds = 0, exchange_seconds = 0, rank_wall_seconds = 0;
     uint64_t rays = 0, hits = 0, bytes_sent = 0;
+    uint64_t file_resident_bytes = 0;   ///< of the rank's mapping of the .oct after its frames (smaps)
     int threads = 0;
     bool wrote = false;   ///< this rank wrote the image (its own step, or rank 0 of a split frame)
 };
@@ -61,10 +63,15 @@ public:
     std::vector<int> tiles_of(int tile_count) const;   ///< sort-first: tile i with i % size == rank
     RankExchange gather_tiles(const TileGrid& grid, bool colour, bool depth, bool normal, Frame& frame);
     RankExchange composite(const CompositeLayout& layout, Frame& frame);
+    /// Sort-last, collective: this rank's ghost plane (mpi/ghost_exchange.h) for `bricks`, from
+    /// the rank that owns it; `decode(x)` gives this rank's own first plane to the rank before.
+    std::shared_ptr<const std::vector<double>> ghost_plane(const std::vector<CellBox>& bricks,
+                                                           const std::function<std::vector<double>(uint32_t)>& decode,
+                                                           uint64_t& bytes_sent);
     /// Runs render(n) for the jobs 0 .. count-1 dealt to this rank.
     void deal(size_t count, const std::function<void(size_t)>& render);
     /// Rank 0: every rank's records (this rank's first); others: their own. Collective.
-    std::vector<FrameRecord> gather_records(std::vector<FrameRecord> mine, double wall_seconds);
+    std::vector<FrameRecord> gather_records(std::vector<FrameRecord> mine, double wall_seconds, uint64_t file_resident_bytes);
 
 private:
     struct Mpi;

@@ -19,9 +19,11 @@ template <typename T> TracerKernel build_tracer_kernel(const Octree<T>& tree, co
         auto tracer = std::make_shared<Tracer>(tree, placement, options.isovalues.data(), int(options.isovalues.size()),
                                                finder);
         if (options.packet_min_lanes > 0) tracer->set_min_packet_lanes(options.packet_min_lanes);
-        if (options.owned_cells) tracer->set_owned_cells(*options.owned_cells);
+        if (options.owned_cells)
+            tracer->set_owned_cells(*options.owned_cells, options.ghost_plane ? options.ghost_plane->data() : nullptr);
         TracerKernel k;
         k.user = tracer.get();
+        k.ghost_plane = options.ghost_plane;   // the tracer reads it: kept alive with the kernel
         k.tracer = std::move(tracer);
         k.isa = isa;
         k.trace = [](const void* user, const Ray& ray, bool normal) {

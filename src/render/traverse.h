@@ -88,9 +88,12 @@ public:
     /// are computed exactly as without the box, so a hit inside it is the whole volume's hit bit
     /// for bit; cells are half-open along the ray, so a surface on a box face is claimed by the
     /// box whose cell the ray enters there, once. Not thread-safe against a frame in flight.
-    void set_owned_cells(const CellBox& box) {
+    /// `ghost_plane` (may be null): the voxels of x = box.hi[0], element y + ny * z, read in
+    /// place of the octree for the +x corners of the box's last cells (RenderOptions::ghost_plane).
+    void set_owned_cells(const CellBox& box, const double* ghost_plane = nullptr) {
         restricted_ = true;
         owned_ = box;
+        ghost_ = ghost_plane;
     }
 
     /// First hits of rays[0 .. count), count <= kMaxPacket; lanes with valid[k] == 0 (valid may be
@@ -130,6 +133,13 @@ private:
         for (int a = 0; a < 3; ++a)
             if (uint64_t(lo[a]) + side <= owned_.lo[a] || lo[a] >= owned_.hi[a]) return false;
         return true;
+    }
+    /// Whether cell v is in the owned box's last x layer with a ghost plane beyond it.
+    bool ghost_face(const Coord& v) const { return ghost_ && v.x + 1 == owned_.hi[0]; }
+    /// Corner k (x offset 1) of such a cell, from the ghost plane.
+    double ghost_value(const Coord& v, int k) const {
+        const uint64_t y = v.y + ((k >> 1) & 1), z = v.z + ((k >> 2) & 1);
+        return ghost_[z * tree_.dims().y + y];
     }
     bool owns_cell(const int64_t cell[3]) const {
         for (int a = 0; a < 3; ++a)
@@ -312,7 +322,12 @@ private:
                 return;
             }
             const int oct = int(((v.x - co.x) << 2) | ((v.y - co.y) << 1) | (v.z - co.z));
+            const bool on_ghost = ghost_face(v);
             for (int k = 0; k < 8; ++k) {
+                if (on_ghost && (k & 1)) {
+                    corner[k] = ghost_value(v, k);
+                    continue;
+                }
                 const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
                 const int r = oct & dir;                                         // which block holds the corner
                 if (r == 0) {
@@ -339,11 +354,12 @@ private:
                 return;
             }
             const uint32_t ex = co.x + side, ey = co.y + side, ez = co.z + side;
+            const bool on_ghost = ghost_face(p);
             for (int k = 0; k < 8; ++k) {
                 const Coord dest{p.x + (k & 1), p.y + ((k >> 1) & 1), p.z + ((k >> 2) & 1)};
-                corner[k] = (dest.x < ex && dest.y < ey && dest.z < ez)
-                                ? v
-                                : double(tree_.neighbour_find(p, dest, holder_depth, trace));
+                corner[k] = (dest.x < ex && dest.y < ey && dest.z < ez) ? v
+                            : (on_ghost && (k & 1))                     ? ghost_value(p, k)
+                                                                        : double(tree_.neighbour_find(p, dest, holder_depth, trace));
             }
         };
         bool iso_equals_value = false;
@@ -413,6 +429,7 @@ private:
     int min_packet_lanes_ = kDefaultMinPacketLanes;
     bool restricted_ = false;   ///< set_owned_cells() was called
     CellBox owned_;
+    const double* ghost_ = nullptr;   ///< the plane x = owned_.hi[0], or null
     [[no_unique_address]] const Corners corners_;
     [[no_unique_address]] const Recorder recorder_;
 };

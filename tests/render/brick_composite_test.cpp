@@ -18,7 +18,18 @@
 namespace octiso::test {
 namespace {
 
-Frame composite_of_bricks(const OctreeData<float>& data, const Camera& camera, RenderOptions options, int count) {
+/// The voxels of plane x of `v` (element y + ny * z), as RenderOptions::ghost_plane holds them.
+std::shared_ptr<const std::vector<double>> plane_of(const DenseVolume<float>& v, uint32_t x) {
+    auto plane = std::make_shared<std::vector<double>>();
+    for (uint32_t z = 0; z < v.dims.z; ++z)
+        for (uint32_t y = 0; y < v.dims.y; ++y) plane->push_back(v.values[x + uint64_t(v.dims.x) * (y + uint64_t(v.dims.y) * z)]);
+    return plane;
+}
+
+/// Every brick rendered alone and composited; with `ghosts`, the bricks read their +x face from a
+/// plane of the dense volume (as under mpirun) instead of the neighbour's nodes.
+Frame composite_of_bricks(const OctreeData<float>& data, const DenseVolume<float>& v, const Camera& camera,
+                          RenderOptions options, int count, bool ghosts) {
     const CompositeLayout layout{options.want_colour, options.want_normal};
     const bool wanted_depth = options.want_depth;
     options.want_depth = true;   // the composite needs it
@@ -27,6 +38,8 @@ Frame composite_of_bricks(const OctreeData<float>& data, const Camera& camera, R
     for (int r = 0; r < count; ++r) {
         RenderOptions brick_options = options;
         brick_options.owned_cells = bricks[size_t(r)];
+        if (ghosts && !bricks[size_t(r)].empty() && bricks[size_t(r)].hi[0] + 1 < v.dims.x)
+            brick_options.ghost_plane = plane_of(v, bricks[size_t(r)].hi[0]);
         const Frame f = Renderer(data.view(), Placement{}, brick_options).render(camera);
         pack_composite(f, uint32_t(r), layout, mine);
         if (r == 0) result = mine;
@@ -100,7 +113,9 @@ TEST(BrickComposite, EqualsTheWholeVolume) {
                     const std::string what = "field " + std::to_string(int(field)) + ", " + std::to_string(count) +
                                              " bricks, embree " + std::to_string(embree) + ", packets " +
                                              std::to_string(traversal == Traversal::packets);
-                    expect_same(composite_of_bricks(data, camera, o, count), whole, what);
+                    for (const bool ghosts : {false, true})
+                        expect_same(composite_of_bricks(data, v, camera, o, count, ghosts), whole,
+                                    what + (ghosts ? ", ghost planes" : ""));
                 }
             }
     }
@@ -122,7 +137,9 @@ TEST(BrickComposite, SurfaceOnABrickFaceIsClaimedOnce) {
         o.isovalues = {16};
         o.want_depth = o.want_normal = true;
         const Frame whole = Renderer(data.view(), Placement{}, o).render(camera);
-        for (int count : {2, 4}) expect_same(composite_of_bricks(data, camera, o, count), whole, "azimuth " + std::to_string(azimuth));
+        for (int count : {2, 4})
+            for (const bool ghosts : {false, true})
+                expect_same(composite_of_bricks(data, v, camera, o, count, ghosts), whole, "azimuth " + std::to_string(azimuth));
     }
 }
 
