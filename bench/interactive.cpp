@@ -2,8 +2,9 @@
 // and decoded, through octiso-view's own server (in process, real HTTP on loopback, one client
 // connection: what the page does), at each image size. Next to it, what the same change costs
 // the mesh path before its first ray: flying-edges extraction + Embree BVH build (peers_mesh.h).
-// The browser's own PNG decode and paint are not in these numbers; the client here decodes the
-// PNG with OpenImageIO instead, so the figure covers request, render, encode, transfer, decode.
+// The client asks for the page's loopback format (raw RGBA, request.h), so the figure covers
+// request, render, the RGBA widening, transfer; the browser's canvas and paint are not in it
+// (bench/interactive_browser.py measures those).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,8 +23,6 @@
 #ifdef OCTISO_HAVE_VIEW
 #include <unistd.h>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <httplib.h>
 
 #include "view/server.h"
@@ -40,7 +39,7 @@ const char* const kInteractiveUsage =
     "  default datasets ch2better and marschner-lobb:256 (--quick: marschner-lobb:64 for the synthetic);\n"
     "  --changes isovalue changes per size (default 60, --quick 4), --threads render threads (default 2);\n"
     "  mesh: median of 3 isovalues (--quick: 1).\n"
-    "  Latency: GET /frame sent -> PNG received and decoded, p50 and p95; mesh: extraction + BVH per change;\n"
+    "  Latency: GET /frame sent -> RGBA frame received (the page's loopback format), p50 and p95; mesh: extraction + BVH per change;\n"
     "  orbit: --changes azimuth steps at a third of the side (the page's drag frames), frames/s back to back.";
 
 #ifdef OCTISO_HAVE_VIEW
@@ -61,18 +60,14 @@ double percentile(std::vector<double> v, double p) {
     return v[i];
 }
 
-/// Decodes the PNG bytes (as the page's browser would) and returns the pixel count read.
-size_t decode_png(const std::string& png) {
-    std::vector<unsigned char> bytes(png.begin(), png.end());
-    OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
-    // The proxy goes in with create(), so the reader never looks for a file of that name.
-    auto in = OIIO::ImageInput::open("frame.png", nullptr, &memory);
-    if (!in) throw Error("interactive", "cannot decode the frame PNG: " + OIIO::geterror(), ErrorKind::Other);
-    const OIIO::ImageSpec& spec = in->spec();
-    std::vector<unsigned char> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data()))
-        throw Error("interactive", "cannot decode the frame PNG", ErrorKind::Other);
-    return size_t(spec.width) * size_t(spec.height);
+/// Checks a frame as the page receives it on loopback (raw RGBA, enc=rgba: nothing to decode,
+/// request.h) and returns its pixel count; a reply of another size is an error.
+size_t check_rgba(const std::string& body, int width, int height) {
+    const size_t pixels = size_t(width) * size_t(height);
+    if (body.size() != pixels * 4)
+        throw Error("interactive", "frame of " + std::to_string(body.size()) + " bytes, expected " + std::to_string(width) + "x" +
+                                       std::to_string(height) + "x4", ErrorKind::Other);
+    return pixels;
 }
 
 int run_interactive(cli::Args& args) {
@@ -148,14 +143,14 @@ int run_interactive(cli::Args& args) {
                 std::vector<double> latency, render;
                 for (int i = -2; i < changes; ++i) {   // two warm-up frames build the Renderer
                     char target[256];
-                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d", iso_of(i + 2),
+                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d&enc=rgba", iso_of(i + 2),
                                   kDefaultAzimuthDeg, kDefaultElevationDeg, side, side, i + 3);
                     const auto t0 = std::chrono::steady_clock::now();
                     auto res = client.Get(target);
                     if (!res || res->status != 200)
                         throw Error(name, "viewer replied " + (res ? std::to_string(res->status) + " " + res->body : std::string("nothing")),
                                     ErrorKind::Other);
-                    decode_png(res->body);
+                    check_rgba(res->body, side, side);
                     const double ms = seconds_since(t0) * 1e3;
                     if (i < 0) continue;
                     latency.push_back(ms);
@@ -171,12 +166,12 @@ int run_interactive(cli::Args& args) {
                 const auto orbit_start = std::chrono::steady_clock::now();
                 for (int i = 0; i < changes; ++i) {
                     char target[256];
-                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d", iso_of(0),
+                    std::snprintf(target, sizeof target, "/frame?iso=%.17g&az=%.17g&el=%.17g&w=%d&h=%d&seq=%d&enc=rgba", iso_of(0),
                                   kDefaultAzimuthDeg + 2.0 * (i + 1), kDefaultElevationDeg, row.preview_side, row.preview_side, i);
                     const auto t0 = std::chrono::steady_clock::now();
                     auto res = client.Get(target);
                     if (!res || res->status != 200) throw Error(name, "viewer refused an orbit frame", ErrorKind::Other);
-                    decode_png(res->body);
+                    check_rgba(res->body, row.preview_side, row.preview_side);
                     orbit.push_back(seconds_since(t0) * 1e3);
                 }
                 row.orbit_fps = double(changes) / seconds_since(orbit_start);
@@ -215,7 +210,7 @@ int run_interactive(cli::Args& args) {
         if (std::fscanf(f, "%lf", &load) != 1) load = -1;
         std::fclose(f);
     }
-    std::cout << "isovalue change -> frame received and decoded, octiso-view over loopback, " << threads << " render thread(s) ("
+    std::cout << "isovalue change -> RGBA frame received, octiso-view over loopback, " << threads << " render thread(s) ("
               << machine_description() << "; load average " << fmt(load, 2) << ")\n";
     table.print(std::cout);
     const std::string path = write_json(results, "interactive", [&](cli::JsonWriter& j) {

@@ -10,9 +10,13 @@
 
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "cli/common/json.h"
 #include "cli/common/output_path.h"
+#include "cli/common/progress.h"
 #include "cli/common/report.h"
 #include "octiso/any_octree.h"
 #include "octiso/build.h"
@@ -45,7 +49,11 @@ constexpr const char* kUsage =
     "  --offset BYTES            raw input: header bytes to skip (default 0)\n"
     "  --spacing SX,SY,SZ        world size of a voxel step (default 1,1,1 or the header's)\n"
     "  --origin OX,OY,OZ         world position of voxel 0,0,0 (default 0,0,0 or the header's)\n"
+    "  --array NAME              the point data array of a VTK file with several (default: its active\n"
+    "                            scalars, else its first array)\n"
     "  --iso-range LO,HI         clamp what cannot reach (LO, HI): smaller, exact for isovalues inside\n"
+    "                            (LO, HI, --tolerance and --nan-as in real values: a NIfTI's scl_slope/\n"
+    "                            scl_inter applied)\n"
     "                            (default: none, every isovalue exact)\n"
     "  --tolerance EPS           merge siblings within EPS: lossy, error <= EPS (default 0, lossless)\n"
     "  --nan-as V                replace NaN and +-inf by V (default: refuse non-finite input)\n"
@@ -76,37 +84,6 @@ std::array<double, 3> positive_vec3(const std::string& text, const std::string& 
     return v;
 }
 
-/// Progress of an out-of-core conversion on stderr (issue 13): only when stderr is a terminal,
-/// not with --json, and only once the conversion has run for a second; redrawn at most 4 times a
-/// second on one line, which finish() ends. Bytes are the input's voxel bytes.
-class ProgressLine {
-public:
-    explicit ProgressLine(bool wanted) : wanted_(wanted && ::isatty(STDERR_FILENO)), t0_(Clock::now()) {}
-    void update(uint64_t done, uint64_t all, uint64_t voxels) {
-        if (!wanted_) return;
-        const auto now = Clock::now();
-        const double t = std::chrono::duration<double>(now - t0_).count();
-        if (t < 1.0 || (shown_ && std::chrono::duration<double>(now - last_).count() < 0.25)) return;
-        last_ = now;
-        shown_ = true;
-        const double rate = double(done) / t;
-        const double eta = rate > 0 ? double(all - std::min(done, all)) / rate : 0;
-        std::fprintf(stderr, "\r  read %.0f of %.0f MiB, %.1f Mvoxel/s, ETA %.0f s   ", double(done) / 1048576.0,
-                     double(all) / 1048576.0, double(voxels) / t / 1e6, eta);
-        std::fflush(stderr);
-    }
-    void finish() {
-        if (shown_) std::fputc('\n', stderr);
-        shown_ = false;
-    }
-
-private:
-    using Clock = std::chrono::steady_clock;
-    bool wanted_;
-    bool shown_ = false;
-    Clock::time_point t0_, last_;
-};
-
 /// --memory BYTES: a positive integer with an optional K, M or G suffix (powers of 1024).
 uint64_t parse_memory(const std::string& text) {
     uint64_t scale = 1;
@@ -124,7 +101,7 @@ uint64_t parse_memory(const std::string& text) {
 
 /// The flags that say where the steps come from, in the order they are checked (so that of
 /// several bad flags, the same one is named first every time).
-ConvertSource parse_source(cli::Args& args) {
+ConvertSource parse_source(const cli::Flags& args) {
     const auto synthetic = args.value("--synthetic");
     const auto steps = args.value("--steps");
     const auto dims = args.value("--dims");
@@ -134,6 +111,10 @@ ConvertSource parse_source(cli::Args& args) {
     RawOptions raw;
     if (const auto s = args.value("--spacing")) raw.spacing = positive_vec3(*s, "--spacing");
     if (const auto o = args.value("--origin")) raw.origin = cli::parse_vec3(*o, "--origin");
+    if (const auto a = args.value("--array")) {
+        if (a->empty()) throw Error("--array", "expected the name of a point data array");
+        raw.array = *a;
+    }
     const std::vector<std::string> positional = args.positional();
 
     std::optional<ScalarType> t;
@@ -147,6 +128,7 @@ ConvertSource parse_source(cli::Args& args) {
         if (steps) throw Error("--steps", "does not combine with --synthetic (use plume-series:N,STEPS)");
         for (const auto& [flag, given] : {std::pair{"--dims", bool(dims)}, {"--endian", bool(endian)}, {"--offset", bool(offset)}})
             if (given) throw Error(flag, "applies only to raw input, not to --synthetic");
+        if (raw.array) throw Error("--array", "picks an array of a VTK file, not of --synthetic");
         return ConvertSource::synthetic(*synthetic, t, raw);
     }
 
@@ -172,13 +154,23 @@ ConvertSource parse_source(cli::Args& args) {
 
 /// The range of values the file stores: the union of its steps' root min/max (what octiso-render
 /// accepts as isovalues), read back from the finished file so that it reports what was written.
+/// In real values (CONVENTIONS 2b): the stored range through the file's value scale.
 std::optional<std::array<double, 2>> stored_range(const std::string& path) {
     const auto file = std::make_shared<const OctFile>(OctFile::open(path, Verify::IndicesOnly));
     std::optional<std::array<double, 2>> r;
     for (uint32_t k = 0; k < file->info().step_count; ++k)
         if (const auto v = AnyOctree::step(file, k).info().value_range)
             r = r ? std::array<double, 2>{std::min((*r)[0], (*v)[0]), std::max((*r)[1], (*v)[1])} : *v;
+    if (r) r = file->info().value_scale.real_range(*r);
     return r;
+}
+
+/// "x,z" for the axes of a flipped-axes mask.
+std::string axes_text(uint8_t mask) {
+    std::string s;
+    for (int a = 0; a < 3; ++a)
+        if (mask & (1u << a)) s += std::string(s.empty() ? "" : ",") + "xyz"[a];
+    return s;
 }
 
 void write_json(std::ostream& os, const ConvertReport& r, const std::optional<std::array<double, 2>>& range) {
@@ -212,6 +204,12 @@ void write_json(std::ostream& os, const ConvertReport& r, const std::optional<st
     if (r.iso_range) j.key("iso_range").array(*r.iso_range);
     else j.key("iso_range").null();
     j.field("tolerance", r.tolerance);
+    j.key("value_scale").begin_object().field("slope", r.value_scale.slope).field("inter", r.value_scale.inter).end_object();
+    j.key("flipped_axes").begin_array();
+    for (int a = 0; a < 3; ++a)
+        if (r.flipped_axes & (1u << a)) j.value(std::string(1, "xyz"[a]));
+    j.end_array();
+    j.key("warnings").array(r.warnings);
     j.field("build_seconds", r.build_seconds).field("total_seconds", r.total_seconds);
     j.field("mvoxels_per_second", r.mvoxels_per_second());
     j.field("peak_rss_bytes", r.peak_rss_bytes).field("threads", r.threads);
@@ -223,11 +221,22 @@ void write_json(std::ostream& os, const ConvertReport& r, const std::optional<st
 
 void write_human(std::ostream& os, const ConvertReport& r, const std::optional<std::array<double, 2>>& range) {
     const StepSizes& tot = r.total;
+    for (const std::string& w : r.warnings) os << "octiso-convert: warning: " << r.input << ": " << w << "\n";
     os << "octiso-convert: " << r.input << " (" << volume_format_name(r.format) << ", " << scalar_type_name(r.type) << " "
        << dims_text(r.dims) << (r.steps > 1 ? ", " + std::to_string(r.steps) + " steps" : "") << ", "
        << mib(r.input_bytes) << ") -> " << r.output << "\n";
     os << "  values " << (range ? cli::number((*range)[0]) + " .. " + cli::number((*range)[1]) : std::string("none (no cell)"))
        << (r.steps > 1 ? " over all steps" : "") << " (the isovalues octiso-render accepts)\n";
+    if (!r.value_scale.is_identity())
+        os << "  real value = stored * " << cli::number(r.value_scale.slope) << " + " << cli::number(r.value_scale.inter)
+           << " (NIfTI scl_slope/scl_inter; the tree keeps the stored " << scalar_type_name(r.type)
+           << ", values and isovalues are real)\n";
+    if (r.flipped_axes)
+        os << "  axes " << axes_text(r.flipped_axes) << " reversed (negative in the NIfTI affine): spacing "
+           << cli::number(r.placement.spacing[0]) << "," << cli::number(r.placement.spacing[1]) << ","
+           << cli::number(r.placement.spacing[2]) << ", origin " << cli::number(r.placement.origin[0]) << ","
+           << cli::number(r.placement.origin[1]) << "," << cli::number(r.placement.origin[2])
+           << "; octiso-info --extract gives the file's order back\n";
     os << std::fixed << std::setprecision(3);
     os << "  file " << mib(r.file_bytes) << ", ratio " << r.ratio() << " (file / raw); interior " << mib(tot.interior_bytes)
        << " (min/max " << mib(tot.minmax_bytes) << "), caps " << mib(tot.cap_bytes) << "\n";
@@ -249,11 +258,14 @@ void write_human(std::ostream& os, const ConvertReport& r, const std::optional<s
 
 /// --synthetic sparse-spheres:N (f32, N^3, N >= 64): built directly as an octree, no dense array
 /// (src/octree/sparse_synthetic.h), so N may be 16384 or more. Only -o and --json apply.
-int convert_sparse_spheres(cli::Args& args, uint32_t n) {
+int convert_sparse_spheres(const cli::Flags& args, uint32_t n) {
     const bool json = args.flag("--json");
-    const auto out = args.value("--output", "-o");
-    args.value("--synthetic");
-    args.finish();
+    const auto out = args.value("--output");
+    for (const std::string& flag : args.given())
+        if (flag != "--output" && flag != "--synthetic")
+            throw Error(flag, "does not apply to --synthetic sparse-spheres (only -o and --json do)");
+    if (args.flag("--in-memory")) throw Error("--in-memory", "does not apply to --synthetic sparse-spheres (only -o and --json do)");
+    if (!args.positional().empty()) throw Error(args.positional()[0], "give either INPUT or --synthetic, not both");
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
     cli::check_output_file(*out, "-o");   // before the work, naming the user's path
     const ConvertReport r = octiso::convert(ConvertSource::sparse_spheres(n), *out, BuildOptions{});
@@ -272,20 +284,24 @@ int convert_sparse_spheres(cli::Args& args, uint32_t n) {
 }
 
 int run(std::vector<std::string>& argv) {
-    cli::Args args(argv);
-    if (args.flag("--help") || args.flag("-h")) {
-        std::cout << kUsage;
-        return 0;
-    }
+    // --help wins over every other argument, as --version does in run_main.
+    for (const std::string& a : argv)
+        if (a == "--help" || a == "-h") {
+            std::cout << kUsage;
+            return 0;
+        }
     if (argv.empty()) {   // the same in every tool: the help, as a usage error
         std::cerr << kUsage;
         return 2;
     }
-    for (size_t i = 0; i + 1 < argv.size(); ++i)   // sparse-spheres never makes a dense array
-        if (argv[i] == "--synthetic")
-            if (const uint32_t n = parse_sparse_spheres(argv[i + 1])) return convert_sparse_spheres(args, n);
+    const cli::Flags args(argv,
+                          {"-o,--output", "--synthetic", "--steps", "--dims", "--type", "--endian", "--offset", "--spacing",
+                           "--origin", "--array", "--iso-range", "--tolerance", "--nan-as", "--threads", "--memory"},
+                          {"--json", "--in-memory"});
+    if (const auto spec = args.value("--synthetic"))   // sparse-spheres never makes a dense array
+        if (const uint32_t n = parse_sparse_spheres(*spec)) return convert_sparse_spheres(args, n);
     const bool json = args.flag("--json");
-    const auto out = args.value("--output", "-o");
+    const auto out = args.value("--output");
     BuildOptions opt;
     if (const auto r = args.value("--iso-range")) opt.iso_range = cli::parse_range(*r, "--iso-range");
     if (const auto t = args.value("--tolerance")) {
@@ -298,12 +314,19 @@ int run(std::vector<std::string>& argv) {
     if (const auto m = args.value("--memory")) memory.budget = parse_memory(*m);
     memory.force_in_memory = args.flag("--in-memory");
     const ConvertSource src = parse_source(args);
-    args.finish();
     if (!out) throw Error("-o", "missing output file (-o OUT.oct)");
     cli::check_output_file(*out, "-o");   // before the work, naming the user's path
 
-    ProgressLine progress(!json);
-    memory.on_progress = [&](uint64_t done, uint64_t all, uint64_t voxels) { progress.update(done, all, voxels); };
+    // Progress (issue 17): slabs read out of core, steps built in memory; only on a terminal,
+    // not with --json, and only once the conversion has run for a second.
+    cli::ProgressLine progress = cli::ProgressLine::on_stderr(!json);
+    const auto t0 = std::chrono::steady_clock::now();
+    memory.on_progress = [&](uint64_t done, uint64_t all, uint64_t voxels) {
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        progress.update(double(done), double(all),
+                        fmt::format("{:.0f} of {:.0f} MiB, {:.1f} Mvoxel/s", double(done) / 1048576.0, double(all) / 1048576.0,
+                                    s > 0 ? double(voxels) / s / 1e6 : 0.0));
+    };
     ConvertReport report;
     try {
         report = octiso::convert(src, *out, opt, memory);

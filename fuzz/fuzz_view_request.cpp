@@ -30,7 +30,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
               (long long)r.width * r.height <= octiso::view::kMaxImagePixels && r.step < step_count &&
               r.zoom >= octiso::view::kMinZoom && r.zoom <= octiso::view::kMaxZoom &&
               r.elevation_deg >= -octiso::view::kMaxElevationDeg && r.elevation_deg <= octiso::view::kMaxElevationDeg &&
-              r.iso - r.iso == 0 && r.azimuth_deg - r.azimuth_deg == 0))
+              r.iso - r.iso == 0 && r.azimuth_deg - r.azimuth_deg == 0 &&
+              (r.encoding == octiso::view::FrameEncoding::png || r.encoding == octiso::view::FrameEncoding::rgba)))
             __builtin_trap();
     } catch (const octiso::Error&) {
     }

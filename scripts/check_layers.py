@@ -22,7 +22,7 @@ LAYERS = [
     ("scene", ["src/scene/"]),
     ("frame", ["include/octiso/render.h", "include/octiso/debug_trace.h", "include/octiso/antialias.h",
                "include/octiso/bricks.h", "include/octiso/depth_composite.h", "src/render/"]),
-    ("api", ["include/octiso/any_octree.h", "include/octiso/value_stats.h", "include/octiso/shading.h", "src/api/"]),
+    ("api", ["include/octiso/any_octree.h", "include/octiso/value_stats.h", "include/octiso/shading.h", "include/octiso/look.h", "src/api/"]),
     ("io", ["include/octiso/reader.h", "include/octiso/image.h", "include/octiso/volume_writer.h", "src/io/"]),
     ("convert", ["include/octiso/convert.h", "src/convert/"]),
     ("reference", ["src/reference/"]),

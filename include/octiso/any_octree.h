@@ -44,6 +44,10 @@ struct AnyOctreeInfo {
     /// [min, max] over the stored values of every data cell, read from the root's 8 child ranges
     /// (so widened by the tolerance of a lossy tree); empty when the grid has no cell (an extent 1).
     std::optional<std::array<double, 2>> value_range;
+    /// Stored-to-real values: value_range, iso_range and tolerance are stored values; tools map
+    /// them with value_scale.real_range() before reporting (CONVENTIONS 2b).
+    ValueScale value_scale;
+    uint8_t flipped_axes = 0;                          ///< source axes reversed at conversion
     uint64_t dense_bytes = 0;                          ///< dims x scalar size: what decode() writes
     std::string source;                                ///< the file or input it came from
 };

@@ -24,6 +24,10 @@ struct BuildOptions {
     std::optional<double> nan_as;
     int threads = 0;               ///< 0: all cores (the caller's tbb::global_control applies)
     std::string source_name;       ///< named in errors
+    /// Recorded with the tree, not used by the build: the source's stored-to-real values and
+    /// reversed axes (volume.h). iso_range, tolerance and nan_as above are stored values.
+    ValueScale value_scale;
+    uint8_t flipped_axes = 0;
 };
 
 /// Counts per depth d = 0 .. dmax-1: stored nodes (interior; caps at dmax-1) and scalar leaves

@@ -73,8 +73,8 @@ struct MemoryOptions {
     uint32_t piece_side = 0;   ///< forces the out-of-core pieces' side (a power of two >= 4; tests); 0: from the budget
     bool force_streaming = false;   ///< out of core even without a budget (tests)
     bool force_in_memory = false;   ///< --in-memory: the whole-array path whatever the size (benchmarks)
-    /// Called from the converting thread after each slab with (bytes read so far, bytes in all, voxels
-    /// built so far); for progress reports. Not called on the in-memory path.
+    /// Called from the converting thread after each slab (out of core) or each step (in memory) with
+    /// (bytes read so far, bytes in all, voxels built so far); for progress reports.
     std::function<void(uint64_t, uint64_t, uint64_t)> on_progress;
 };
 
@@ -101,8 +101,11 @@ struct ConvertReport {
     /// sparse-spheres: built directly as an octree; input_bytes, per_step timings and peak RSS
     /// are then not measured (0).
     bool built_directly = false;
-    std::optional<std::array<double, 2>> iso_range;
-    double tolerance = 0.0;
+    std::optional<std::array<double, 2>> iso_range;   ///< real values, as given
+    double tolerance = 0.0;                            ///< real values, as given
+    ValueScale value_scale;      ///< stored-to-real values of the source (NIfTI scl_slope/scl_inter)
+    uint8_t flipped_axes = 0;    ///< source axes reversed at reading (volume.h)
+    std::vector<std::string> warnings;   ///< readers' notes for the user (an oblique NIfTI)
     std::vector<ConvertStepReport> per_step;
     StepSizes total;             ///< sums over all steps, per depth and per section kind
     uint64_t input_bytes = 0;    ///< dense bytes of the first step times the step count
@@ -123,8 +126,8 @@ struct ConvertReport {
     }
 };
 
-/// Converts `source` into the .oct file `output` with `options` (iso_range, tolerance, nan_as,
-/// threads; source_name is set per step). Step 0 is opened and every other step checked
+/// Converts `source` into the .oct file `output` with `options` (iso_range, tolerance, nan_as in
+/// real values, mapped through the source's value scale; threads; source_name is set per step). Step 0 is opened and every other step checked
 /// against it (dims, type, spacing and origin) before the output is created; a mismatch throws
 /// Error(step file, ...) (exit 2) and writes nothing. Until the file is finished only a
 /// temporary sibling exists, removed on any error. options.threads > 0 limits all TBB work

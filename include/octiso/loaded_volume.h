@@ -33,6 +33,17 @@ public:
     Dims dims() const { return dims_; }
     const Placement& placement() const { return placement_; }
     void set_placement(const Placement& placement) { placement_ = placement; }
+    /// Stored-to-real values and the source axes reversed at reading (NIfTI, CONVENTIONS 2b);
+    /// identity and 0 for every other source.
+    const ValueScale& value_scale() const { return value_scale_; }
+    uint8_t flipped_axes() const { return flipped_axes_; }
+    void set_source_order(const ValueScale& scale, uint8_t flipped_axes) {
+        value_scale_ = scale;
+        flipped_axes_ = flipped_axes;
+    }
+    /// A reader's note for the user (an oblique NIfTI placed as VTK does); empty when none.
+    const std::string& warning() const { return warning_; }
+    void set_warning(std::string w) { warning_ = std::move(w); }
     uint64_t bytes() const { return dims_.voxels() * scalar_type_bytes(type_); }   ///< voxel bytes
     bool swap_bytes() const { return swap_bytes_; }
     const std::byte* data() const { return data_; }
@@ -58,6 +69,9 @@ private:
     ScalarType type_ = ScalarType::u8;
     Dims dims_;
     Placement placement_;
+    ValueScale value_scale_;
+    uint8_t flipped_axes_ = 0;
+    std::string warning_;
     bool swap_bytes_ = false;
     std::string source_;
     VolumeFormat format_ = VolumeFormat::raw;

@@ -26,6 +26,10 @@ struct OctInfo {
     std::optional<std::array<double, 2>> iso_range;   ///< converted with --iso-range LO,HI
     double tolerance = 0.0;                            ///< 0: lossless
     uint32_t step_count = 0;
+    /// Stored-to-real values (NIfTI scl_slope/scl_inter). iso_range and tolerance above, the
+    /// nodes' min/max and the renderer's isovalues are stored values; tools report real ones.
+    ValueScale value_scale;
+    uint8_t flipped_axes = 0;                          ///< source axes reversed at conversion (volume.h)
 };
 
 /// Streams an .oct file: open, add_step() once per time step in order, finish(). Until finish()

@@ -29,7 +29,10 @@ LoadedVolume read_raw(const std::string& path, Dims dims, ScalarType type, Endia
 /// alive inside the handle, no copy is made. Spacing and origin are what VTK's reader reports
 /// (CONVENTIONS 2b). Throws Error(path, ...) for anything VTK cannot read, a multi-component or
 /// 64-bit integer image, or an image VTK reads but whose array does not match its dimensions.
-LoadedVolume read_vtk(const std::string& path, VolumeFormat format);
+/// `array` picks a point data array by name (octiso-convert --array) in a file with several;
+/// without it the file's active scalars are read, else its first array. An unknown name throws
+/// Error(path, ...) listing the arrays the file has.
+LoadedVolume read_vtk(const std::string& path, VolumeFormat format, const std::optional<std::string>& array = std::nullopt);
 
 /// Which format claims `path`: by extension (.nii .nii.gz .vti .vtk .mhd .mha .nrrd .nhdr, any
 /// case), else by magic bytes at the start of the file; raw when nothing claims it.
@@ -44,9 +47,12 @@ struct RawOptions {
     std::optional<uint64_t> offset;
     std::optional<std::array<double, 3>> spacing;
     std::optional<std::array<double, 3>> origin;
+    /// --array NAME: the point data array of a VTK file with several (.vti, legacy .vtk).
+    std::optional<std::string> array;
 };
 
-/// Opens any input: picks the reader with detect_volume_format() (a file whose magic names a
+/// Opens any input: picks the reader with detect_volume_format() (NIfTI: read_nifti() of
+/// src/io/volume_stream.h, placed and scaled as CONVENTIONS 2b says) (a file whose magic names a
 /// format but that comes with --dims/--type is taken as raw), applies the placement overrides
 /// and checks the result (spacing finite and > 0, origin finite). Throws Error naming the file
 /// or the missing flag (--dims, --type) on any problem.

@@ -37,6 +37,14 @@ Isa resolve_isa(Isa requested);
 /// Whether this CPU can run the AVX2 kernel (AVX2 and FMA).
 bool cpu_has_avx2();
 
+/// A clip plane (issue 17 item 7, `--clip NX,NY,NZ,D`): in world coordinates, the half-space
+/// n . p <= d is kept and the rest of the volume is cut away for every ray (primary and
+/// secondary). n need not be unit length (d then scales with |n|); it must be finite and non-zero.
+struct ClipPlane {
+    std::array<double, 3> normal{0, 0, 1};
+    double d = 0;
+};
+
 struct RenderOptions {
     std::vector<double> isovalues;      ///< 1 .. kMaxIsovalues, each with its own colour
     RootFinder root_finder = RootFinder::neubauer;
@@ -61,6 +69,9 @@ struct RenderOptions {
     std::shared_ptr<const std::vector<double>> ghost_plane;
     int threads = 0;                    ///< 0: all cores
     int tile_size = 0;                  ///< square tile side in pixels; 0: tile_size_for() picks it
+    /// Every ray's interval is cut to the intersection of these half-spaces before traversal
+    /// (src/render/clip.h); empty: no clipping, the frames of before bit for bit.
+    std::vector<ClipPlane> clip_planes;
 };
 
 /// What the renderer must know about the octree's source beyond its voxels: a file converted
@@ -115,7 +126,8 @@ private:
 };
 
 /// Throws Error(flag, ...) unless `options` can be rendered: 1 .. kMaxIsovalues finite
-/// isovalues (inside the iso-range of `limits`, if any), a non-negative tile size.
+/// isovalues (inside the iso-range of `limits`, if any), a non-negative tile size, clip planes
+/// with finite, non-zero normals and finite offsets.
 void validate_options(const RenderOptions& options, const RenderLimits& limits = {});
 
 /// One frame in one call: a Renderer built, used once and dropped. Throws Error on bad options.

@@ -82,6 +82,30 @@ struct Placement {
     std::array<double, 3> origin{0.0, 0.0, 0.0};
 };
 
+/// How stored values map to the real values users give and read (NIfTI scl_slope/scl_inter,
+/// CONVENTIONS 2b): real = stored * slope + inter. The octree keeps the stored type; isovalues,
+/// ranges and --iso-range are real values, turned into stored ones at the tools' edge. The
+/// mapping is affine, so the trilinear interpolant commutes with it and {real f = V} is exactly
+/// {stored f = stored(V)}. Invariant: slope finite and non-zero, inter finite.
+struct ValueScale {
+    double slope = 1.0, inter = 0.0;
+    bool is_identity() const { return slope == 1.0 && inter == 0.0; }
+    double real(double stored) const { return is_identity() ? stored : stored * slope + inter; }
+    double stored(double real) const { return is_identity() ? real : (real - inter) / slope; }
+    /// A [lo, hi] range mapped either way, still ordered (a negative slope swaps its ends).
+    std::array<double, 2> real_range(const std::array<double, 2>& s) const { return ordered(real(s[0]), real(s[1])); }
+    std::array<double, 2> stored_range(const std::array<double, 2>& r) const { return ordered(stored(r[0]), stored(r[1])); }
+    bool operator==(const ValueScale&) const = default;
+
+private:
+    static std::array<double, 2> ordered(double a, double b) { return a <= b ? std::array<double, 2>{a, b} : std::array<double, 2>{b, a}; }
+};
+
+/// Axes of the source file that run opposite to the tree's (bit a for axis a = x, y, z): a NIfTI
+/// axis whose affine entry is negative is reversed at conversion, so that spacing stays positive
+/// (CONVENTIONS 2b), and recorded so that extraction can give the file's order back.
+inline constexpr uint8_t kAllAxesFlipped = 7;
+
 /// Placement limits (issue 18): every spacing in [kMinSpacing, kMaxSpacing] (normal, with a
 /// normal square), every corner of the world box within +-kMaxWorldCoordinate (squared distances
 /// in camera framing and ray set-up stay finite), and voxels no smaller than 2^-40 of the box's

@@ -62,6 +62,10 @@ py::dict info_dict(const AnyOctree& tree) {
     d["value_range"] = info.value_range ? py::object(py::make_tuple((*info.value_range)[0], (*info.value_range)[1])) : py::none();
     d["iso_range"] = info.iso_range ? py::object(py::make_tuple((*info.iso_range)[0], (*info.iso_range)[1])) : py::none();
     d["tolerance"] = info.tolerance;
+    // Stored-to-real values (a NIfTI's scl_slope/scl_inter): real = stored * slope + inter. The
+    // ranges above and the isovalues render() takes are stored values here, as in the C++ API.
+    d["value_scale"] = py::make_tuple(info.value_scale.slope, info.value_scale.inter);
+    d["flipped_axes"] = int(info.flipped_axes);
     d["interior_bytes"] = info.sizes.interior_bytes;
     d["minmax_bytes"] = info.sizes.minmax_bytes;
     d["cap_bytes"] = info.sizes.cap_bytes;
@@ -108,7 +112,7 @@ step of a .oct file (octiso.open(...).step(k)). Immutable; copies share the same
             const auto& o = t.placement().origin;
             return py::make_tuple(o[0], o[1], o[2]);
         }, "world position of voxel (0, 0, 0)")
-        .def("info", &info_dict, "A dict: type, dims, shape, spacing, origin, dmax, value_range, iso_range, tolerance, byte counts, nodes and scalar leaves per depth, source.")
+        .def("info", &info_dict, "A dict: type, dims, shape, spacing, origin, dmax, value_range, iso_range, tolerance, value_scale (slope, inter: real = stored * slope + inter), flipped_axes, byte counts, nodes and scalar leaves per depth, source.")
         .def("to_numpy", &to_numpy, "The voxels back as a new array of shape (nz, ny, nx), exactly as built (lossless trees).")
         .def("save", [](const AnyOctree& t, const std::string& path) {
             py::gil_scoped_release release;

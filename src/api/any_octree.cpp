@@ -34,6 +34,8 @@ struct AnyOctree::Impl {
     Placement placement;
     std::optional<std::array<double, 2>> iso_range;
     double tolerance = 0.0;
+    ValueScale value_scale;
+    uint8_t flipped_axes = 0;
     std::string source;
     std::shared_ptr<const OctFile> file;   // keeps the mapping alive for a file step
 };
@@ -115,6 +117,8 @@ std::shared_ptr<TypedOctree<T>> built(OctreeData<T>&& data, const Placement& pla
     impl->placement = placement;
     impl->iso_range = options.iso_range;
     impl->tolerance = options.tolerance;
+    impl->value_scale = options.value_scale;
+    impl->flipped_axes = options.flipped_axes;
     impl->source = options.source_name;
     return impl;
 }
@@ -136,6 +140,8 @@ AnyOctree AnyOctree::adopt(OctreeData<T>&& data, const Placement& placement, con
 AnyOctree AnyOctree::build(const LoadedVolume& volume, const BuildOptions& options) {
     BuildOptions named = options;
     if (named.source_name.empty()) named.source_name = volume.source();
+    named.value_scale = volume.value_scale();
+    named.flipped_axes = volume.flipped_axes();
     return dispatch_scalar_type(volume.type(), [&](auto tag) {
         using T = decltype(tag);
         return build(volume.view<T>(), volume.placement(), named);
@@ -153,6 +159,8 @@ AnyOctree AnyOctree::step(std::shared_ptr<const OctFile> file, uint32_t k) {
     impl->placement = info.placement;
     impl->iso_range = info.iso_range;
     impl->tolerance = info.tolerance;
+    impl->value_scale = info.value_scale;
+    impl->flipped_axes = info.flipped_axes;
     impl->source = file->path();
     impl->file = std::move(file);
     return AnyOctree(std::move(impl));
@@ -177,6 +185,8 @@ AnyOctreeInfo AnyOctree::info() const {
     i.dmax = header.dmax;
     i.iso_range = header.iso_range;
     i.tolerance = header.tolerance;
+    i.value_scale = header.value_scale;
+    i.flipped_axes = header.flipped_axes;
     i.sizes = impl_->sizes();
     i.value_range = impl_->value_range();
     i.dense_bytes = dense_bytes();
@@ -192,6 +202,8 @@ OctInfo AnyOctree::oct_info() const {
     info.dmax = dmax();
     info.iso_range = impl_->iso_range;
     info.tolerance = impl_->tolerance;
+    info.value_scale = impl_->value_scale;
+    info.flipped_axes = impl_->flipped_axes;
     return info;
 }
 

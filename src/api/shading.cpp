@@ -7,6 +7,7 @@
 
 #include "math/vec.h"
 #include "octiso/error.h"
+#include "api/hit_colour.h"
 #include "render/light_kit.h"
 #include "render/pinhole_camera.h"
 #include "render/shade.h"
@@ -14,36 +15,6 @@
 namespace octiso {
 
 namespace {
-
-/// The trilinear interpolant at world point `p` (CONVENTIONS 1), clamped into the data's cells.
-template <typename T> double field_at(const Octree<T>& tree, const Placement& placement, const Vec3& p) {
-    const uint32_t n[3] = {tree.dims().x, tree.dims().y, tree.dims().z};
-    uint32_t lo[3], hi[3];
-    double f[3];
-    for (int a = 0; a < 3; ++a) {
-        const double q = (p[a] - placement.origin[a]) / placement.spacing[a];
-        const double top = double(n[a] > 1 ? n[a] - 2 : 0);
-        const double cell = std::isfinite(q) ? std::clamp(std::floor(q), 0.0, top) : 0.0;
-        lo[a] = uint32_t(cell);
-        hi[a] = n[a] > 1 ? lo[a] + 1 : lo[a];
-        f[a] = n[a] > 1 && std::isfinite(q) ? std::clamp(q - cell, 0.0, 1.0) : 0.0;
-    }
-    double v = 0;
-    for (int c = 0; c < 8; ++c) {
-        const Coord at{(c & 4) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 1) ? hi[2] : lo[2]};
-        const double w = ((c & 4) ? f[0] : 1 - f[0]) * ((c & 2) ? f[1] : 1 - f[1]) * ((c & 1) ? f[2] : 1 - f[2]);
-        v += w * double(tree.point_locate(at));
-    }
-    return v;
-}
-
-/// Index of the isovalue nearest to v.
-int nearest_isovalue(double v, const std::vector<double>& isovalues) {
-    int best = 0;
-    for (int i = 1; i < int(isovalues.size()); ++i)
-        if (std::fabs(v - isovalues[size_t(i)]) < std::fabs(v - isovalues[size_t(best)])) best = i;
-    return best;
-}
 
 float linear_from_srgb(double s) { return float(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4)); }
 
@@ -83,9 +54,7 @@ void shade_frame(const AnyOctree& tree, const std::vector<double>& isovalues, co
                                  ray.origin[2] + double(t) * ray.dir[2]};
                     iso = nearest_isovalue(field_at(octree, tree.placement(), p), isovalues);
                 }
-                const float* albedo = size_t(iso) < shading.colours.size() && shading.colours[size_t(iso)]
-                                          ? shading.colours[size_t(iso)]->data()
-                                          : kAlbedo[iso % kMaxIsovalues];
+                const float* albedo = albedo_of(shading, iso);
                 std::array<double, 3> rgb;
                 if (shading.model == ShadingModel::kit) {
                     rgb = shade_light_kit(kit, to_light, normal, ray.dir, albedo);

@@ -3,7 +3,9 @@
 // validated (checksums and indices) before it is reported. The value figures (range, exact
 // percentiles, histogram) come from the tree (value_stats.h), so a wrong --type or --endian at
 // conversion shows at once.
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <unistd.h>
 #include <cstring>
@@ -14,10 +16,12 @@
 #include <vector>
 
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "cli/common/json.h"
 #include "cli/common/output_path.h"
 #include "cli/common/report.h"
 #include "format/oct_layout.h"
+#include "io/volume_stream.h"
 #include "util/atomic_output.h"
 #include "octiso/any_octree.h"
 #include "octiso/error.h"
@@ -42,9 +46,11 @@ constexpr const char* kUsage =
     "  --json                    one JSON object on stdout; the text report goes to stderr\n"
     "  --bins N                  histogram bins, 1..4096 (default 16)\n"
     "  --verify                  recompute every min/max and scalar from the leaves (exit 2 on a lie)\n"
-    "  --extract-raw OUT.raw     write one step back as a raw x-fastest array, byte for byte\n"
-    "  --extract OUT.vti|.nrrd|.raw   the same with a header VTK, ParaView, 3D Slicer read (type,\n"
-    "                            dims, spacing, origin); .raw as --extract-raw\n"
+    "  --extract-raw OUT.raw     write one step back as a raw x-fastest array, byte for byte (stored\n"
+    "                            values, in the source file's axis order)\n"
+    "  --extract OUT.vti|.nrrd|.nii|.nii.gz|.raw   the same with a header VTK, ParaView, 3D Slicer,\n"
+    "                            nibabel read (type, dims, spacing, origin; .nii also the sform and\n"
+    "                            scl_slope/scl_inter, in the source's axis order); .raw as --extract-raw\n"
     "  --step K                  the step --extract(-raw) writes (default 0)\n"
     "  --endian little|big       byte order of raw output (default little)\n"
     "  --version, -h/--help\n";
@@ -73,12 +79,23 @@ void extract_raw(const std::shared_ptr<const OctFile>& file, Extract& ex) {
     if (ex.with_header) {   // the formats' own byte order declaration: native
         step.decode(data, std::endian::native);
         file->check_unchanged();
-        write_volume_file(ex.path, info.type, info.dims, info.placement, data);
+        write_volume_file(ex.path, info.type, info.dims, info.placement, data, info.value_scale, info.flipped_axes);
         return;
     }
     step.decode(data, ex.big_endian ? std::endian::big : std::endian::little);
     file->check_unchanged();   // issue 18: the decoded data came from what was validated
+    // Raw is the source's bytes back: axes reversed at conversion turned round again (.raw
+    // through --extract does the same); reversing moves whole values, so the byte order stays.
+    if (info.flipped_axes) reverse_axes_in_place(data.data(), info.dims, info.dims.z, scalar_type_bytes(info.type), info.flipped_axes);
     write_file_atomically(ex.path, data.data(), ex.bytes);   // every write, fsync and close checked
+}
+
+/// "x, z (NIfTI affine negative)" for a flipped-axes mask.
+std::string flipped_text(uint8_t mask) {
+    std::string s;
+    for (int a = 0; a < 3; ++a)
+        if (mask & (1u << a)) s += std::string(s.empty() ? "" : ", ") + "xyz"[a];
+    return s;
 }
 
 std::string join(const std::vector<uint64_t>& v) {
@@ -97,17 +114,48 @@ struct StepValues {
     ValueStats stats;
 };
 
+/// One step's values in real values (CONVENTIONS 2b: real = stored * slope + inter). The tree's
+/// statistics are of stored values; an affine map moves every figure with it. A negative slope
+/// reverses the order: the histogram is read backwards and percentile p is the stored one of
+/// level 100 - p (exact up to the one rank nearest-rank percentiles can differ by).
+struct RealValues {
+    std::optional<std::array<double, 2>> root_range;
+    uint64_t voxels = 0, non_finite = 0;
+    std::array<double, 2> range{0, 0};
+    std::array<double, 7> percentiles{};
+    std::vector<double> edges;      ///< counts.size() + 1 bin edges, ascending
+    std::vector<uint64_t> counts;
+};
+
+RealValues real_values(const StepValues& v, const ValueScale& scale) {
+    const ValueStats& s = v.stats;
+    RealValues r;
+    if (v.root_range) r.root_range = scale.real_range(*v.root_range);
+    r.voxels = s.voxels;
+    r.non_finite = s.non_finite;
+    r.range = scale.real_range(s.range);
+    r.counts = s.counts;
+    for (int b = 0; b <= int(s.counts.size()); ++b) r.edges.push_back(scale.real(s.bin_edge(b)));
+    const bool reversed = scale.slope < 0;
+    if (reversed) {
+        std::reverse(r.counts.begin(), r.counts.end());
+        std::reverse(r.edges.begin(), r.edges.end());
+    }
+    const size_t n = s.percentiles.size();
+    for (size_t i = 0; i < n; ++i) r.percentiles[i] = scale.real(s.percentiles[reversed ? n - 1 - i : i]);
+    return r;
+}
+
 /// The union of the steps' root ranges: the isovalues octiso-render accepts for this file.
-std::optional<std::array<double, 2>> file_range(const std::vector<StepValues>& values) {
+std::optional<std::array<double, 2>> file_range(const std::vector<RealValues>& values) {
     std::optional<std::array<double, 2>> r;
-    for (const StepValues& v : values)
+    for (const RealValues& v : values)
         if (v.root_range) r = r ? std::array<double, 2>{std::min((*r)[0], (*v.root_range)[0]), std::max((*r)[1], (*v.root_range)[1])}
                                 : *v.root_range;
     return r;
 }
 
-void human_values(std::ostream& os, const StepValues& v) {
-    const ValueStats& s = v.stats;
+void human_values(std::ostream& os, const RealValues& s) {
     os << "    values                   ";
     if (s.voxels == 0) os << "none finite";
     else os << "min " << cli::number(s.range[0]) << ", max " << cli::number(s.range[1]) << " over " << s.voxels << " voxels";
@@ -117,12 +165,12 @@ void human_values(std::ostream& os, const StepValues& v) {
     os << "    percentiles              ";
     for (size_t i = 0; i < s.percentiles.size(); ++i)
         os << (i ? "  " : "") << cli::number(ValueStats::percentile_levels[i]) << "%: " << cli::number(s.percentiles[i]);
-    os << "\n    histogram (" << s.counts.size() << " bins from " << cli::number(s.bin_edge(0)) << " to "
-       << cli::number(s.bin_edge(int(s.counts.size()))) << ")  " << join(s.counts) << "\n";
+    os << "\n    histogram (" << s.counts.size() << " bins from " << cli::number(s.edges.front()) << " to "
+       << cli::number(s.edges.back()) << ")  " << join(s.counts) << "\n";
 }
 
 void human_report(std::ostream& os, const OctFile& file, const std::vector<StepSizes>& steps,
-                  const std::vector<StepValues>& values, const Extract* ex) {
+                  const std::vector<RealValues>& values, const Extract* ex) {
     const OctInfo& in = file.info();
     const cli::WorldBox box = cli::world_box(in.dims, in.placement);
     const auto range = file_range(values);
@@ -142,11 +190,22 @@ void human_report(std::ostream& os, const OctFile& file, const std::vector<StepS
     if (range) os << cli::number((*range)[0]) << " .. " << cli::number((*range)[1]) << " (exact, the root's min/max"
                   << (in.step_count > 1 ? " over all steps" : "") << "; isovalues outside it draw nothing)\n";
     else os << "none (no cell: an extent is 1)\n";
+    if (!in.value_scale.is_identity())
+        os << "  values      real = stored * " << cli::number(in.value_scale.slope) << " + " << cli::number(in.value_scale.inter)
+           << " (NIfTI scl_slope/scl_inter; every value here is real)\n";
+    if (in.flipped_axes)
+        os << "  flipped     " << flipped_text(in.flipped_axes) << " (reversed from the source file at conversion; "
+           << "--extract .nii/.raw gives its order back)\n";
     os << "  dmax        " << in.dmax << " (cube side " << (uint64_t(1) << in.dmax) << ")\n";
     os << "  iso-range   ";
-    if (in.iso_range) os << (*in.iso_range)[0] << ", " << (*in.iso_range)[1] << "\n";
-    else os << "none (every isovalue exact)\n";
-    os << "  tolerance   " << in.tolerance << (in.tolerance == 0 ? " (lossless)" : "") << "\n";
+    if (in.iso_range) {
+        const auto r = in.value_scale.real_range(*in.iso_range);
+        os << r[0] << ", " << r[1] << "\n";
+    } else {
+        os << "none (every isovalue exact)\n";
+    }
+    const double tolerance = in.tolerance * std::fabs(in.value_scale.slope);
+    os << "  tolerance   " << tolerance << (tolerance == 0 ? " (lossless)" : "") << "\n";
     os << "  steps       " << in.step_count << "\n";
     os << "  file bytes  " << file.file_bytes() << "\n";
     os << "  raw bytes   " << raw << " (dims x " << scalar_type_bytes(in.type) << " bytes x " << in.step_count
@@ -164,10 +223,14 @@ void human_report(std::ostream& os, const OctFile& file, const std::vector<StepS
     if (ex)
         os << "  extracted step " << ex->step << " to " << ex->path << " (" << ex->bytes << " bytes, "
            << (ex->big_endian ? "big" : "little") << "-endian)\n";
+    const bool nifti = ex && (ex->path.ends_with(".nii") || ex->path.ends_with(".nii.gz"));
+    if (ex && !nifti && !in.value_scale.is_identity())
+        os << "  note: " << ex->path << " holds the stored values (its format has no value scale): real = stored * "
+           << cli::number(in.value_scale.slope) << " + " << cli::number(in.value_scale.inter) << "\n";
 }
 
 void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSizes>& steps,
-                 const std::vector<StepValues>& values, const Extract* ex) {
+                 const std::vector<RealValues>& values, const Extract* ex) {
     const OctInfo& in = file.info();
     const cli::WorldBox box = cli::world_box(in.dims, in.placement);
     const auto range = file_range(values);
@@ -189,9 +252,14 @@ void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSi
     else j.null();
     j.field("dmax", in.dmax);
     j.key("iso_range");
-    if (in.iso_range) j.array(*in.iso_range);
+    if (in.iso_range) j.array(in.value_scale.real_range(*in.iso_range));
     else j.null();
-    j.field("tolerance", in.tolerance);
+    j.field("tolerance", in.tolerance * std::fabs(in.value_scale.slope));
+    j.key("value_scale").begin_object().field("slope", in.value_scale.slope).field("inter", in.value_scale.inter).end_object();
+    j.key("flipped_axes").begin_array();
+    for (int a = 0; a < 3; ++a)
+        if (in.flipped_axes & (1u << a)) j.value(std::string(1, "xyz"[a]));
+    j.end_array();
     j.field("steps", in.step_count);
     j.field("file_bytes", file.file_bytes());
     j.field("raw_bytes_per_step", raw_step);
@@ -207,27 +275,26 @@ void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSi
         j.field("cap_bytes", s.cap_bytes);
         j.key("nodes_per_depth").array(s.nodes_per_depth);
         j.key("scalar_leaves_per_depth").array(s.scalar_leaves_per_depth);
-        const StepValues& v = values[k];
+        const RealValues& v = values[k];
         j.key("value_range");
         if (v.root_range) j.array(*v.root_range);
         else j.null();
-        j.field("voxels", v.stats.voxels).field("non_finite_voxels", v.stats.non_finite);
+        j.field("voxels", v.voxels).field("non_finite_voxels", v.non_finite);
         j.key("min");
-        if (v.stats.voxels) j.value(v.stats.range[0]);
+        if (v.voxels) j.value(v.range[0]);
         else j.null();
         j.key("max");
-        if (v.stats.voxels) j.value(v.stats.range[1]);
+        if (v.voxels) j.value(v.range[1]);
         else j.null();
         j.key("percentiles").begin_object();
-        for (size_t i = 0; i < v.stats.percentiles.size(); ++i) {
+        for (size_t i = 0; i < v.percentiles.size(); ++i) {
             j.key("p" + cli::number(ValueStats::percentile_levels[i]));
-            if (v.stats.voxels) j.value(v.stats.percentiles[i]);
+            if (v.voxels) j.value(v.percentiles[i]);
             else j.null();
         }
         j.end_object();
-        j.key("histogram").begin_object().key("edges").begin_array();
-        for (int b = 0; b <= int(v.stats.counts.size()); ++b) j.value(v.stats.bin_edge(b));
-        j.end_array().key("counts").array(v.stats.counts).end_object();
+        j.key("histogram").begin_object().key("edges").array(v.edges);
+        j.key("counts").array(v.counts).end_object();
         j.end_object();
     }
     j.end_array();
@@ -247,9 +314,17 @@ void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSi
 
 int main(int argc, char** argv) {
     return octiso::cli::run_main("octiso-info", argc, argv, [](std::vector<std::string>& argv_rest) {
-        cli::Args args(argv_rest);
+        for (const std::string& a : argv_rest)   // --help wins over every other argument
+            if (a == "--help" || a == "-h") {
+                std::cout << kUsage;
+                return 0;
+            }
+        if (argv_rest.empty()) {   // the same in every tool: the help, as a usage error
+            std::cerr << kUsage;
+            return 2;
+        }
+        const cli::Flags args(argv_rest, {"--extract-raw", "--extract", "--step", "--endian", "--bins"}, {"--json", "--verify"});
         const bool json = args.flag("--json");
-        const bool help = args.flag("--help") || args.flag("-h");
         const bool verify = args.flag("--verify");
         const std::optional<std::string> extract_raw_path = args.value("--extract-raw");
         const std::optional<std::string> extract_any_path = args.value("--extract");
@@ -260,15 +335,6 @@ int main(int argc, char** argv) {
         const std::optional<std::string> endian_text = args.value("--endian");
         const std::optional<std::string> bins_text = args.value("--bins");
         const std::vector<std::string> files = args.positional();
-        args.finish();
-        if (help) {
-            std::cout << kUsage;
-            return 0;
-        }
-        if (argv_rest.empty()) {   // the same in every tool: the help, as a usage error
-            std::cerr << kUsage;
-            return 2;
-        }
         if (files.size() != 1)
             throw Error("", std::string(files.empty() ? "no input file" : "more than one input file") + " (octiso-info --help lists every flag)");
         if ((step_text || endian_text) && !extract_path)
@@ -276,13 +342,13 @@ int main(int argc, char** argv) {
         const int bins = bins_text ? int(cli::parse_int(*bins_text, "--bins", 1, 4096)) : 16;
         if (extract_path) refuse_output_onto_input(*extract_path, files, extract_flag);   // issue 18
         if (extract_any_path && !is_volume_file_format(*extract_any_path))
-            throw Error("--extract", "'" + *extract_any_path + "': expected a .vti, .nrrd or .raw name");
+            throw Error("--extract", "'" + *extract_any_path + "': expected a .vti, .nrrd, .nii, .nii.gz or .raw name");
         if (extract_path) cli::check_output_file(*extract_path, extract_flag);
         Extract ex;
         if (extract_path) {
             ex.path = *extract_path;
             ex.with_header = extract_any_path && !(extract_any_path->size() >= 4 && extract_any_path->substr(extract_any_path->size() - 4) == ".raw");
-            if (ex.with_header && endian_text) throw Error("--endian", "applies to raw output only (.vti and .nrrd declare their byte order)");
+            if (ex.with_header && endian_text) throw Error("--endian", "applies to raw output only (.vti, .nrrd and .nii declare their byte order)");
             if (step_text) ex.step = uint32_t(cli::parse_int(*step_text, "--step", 0, UINT32_MAX));
             if (endian_text) {
                 if (*endian_text != "little" && *endian_text != "big")
@@ -298,11 +364,11 @@ int main(int argc, char** argv) {
                                       " (expected 0 .. " + std::to_string(file.info().step_count - 1) + ")");
         std::vector<StepSizes> steps;
         steps.reserve(file.info().step_count);
-        std::vector<StepValues> values;
+        std::vector<RealValues> values;
         for (uint32_t k = 0; k < file.info().step_count; ++k) {
             steps.push_back(file.step_sizes(k));
             const AnyOctree step = AnyOctree::step(shared_file, k);
-            values.push_back({step.info().value_range, value_stats(step, bins)});
+            values.push_back(real_values({step.info().value_range, value_stats(step, bins)}, file.info().value_scale));
         }
         if (verify) {   // issue 18: every min/max and scalar recomputed from the leaves; a lie exits 2
             const VerifyStats v = verify_octree(file);

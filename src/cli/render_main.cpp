@@ -14,8 +14,10 @@
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
 #include "cli/common/output_path.h"
+#include "cli/common/progress.h"
 #include "cli/common/report.h"
 #include "cli/render_camera.h"
+#include "cli/render_look.h"
 #include "cli/render_ranks.h"
 #include "util/process_memory.h"
 #include "octiso/antialias.h"
@@ -26,6 +28,7 @@
 #include "octiso/debug_trace.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
+#include "octiso/look.h"
 #include "octiso/oct_file.h"
 #include "octiso/output_guard.h"
 #include "octiso/render.h"
@@ -76,35 +79,15 @@ const char* kUsage =
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
     "  --version, -h/--help\n";
 
-/// One line of progress with an ETA, redrawn in place; only when stderr is a terminal.
-class Progress {
-public:
-    explicit Progress(long long total) : total_(total), enabled_(total > 1 && ::isatty(2)), start_(std::chrono::steady_clock::now()) {}
-    void update(long long done) {
-        if (!enabled_) return;
-        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-        const double eta = done > 0 ? elapsed / double(done) * double(total_ - done) : 0.0;
-        const int width = 30, filled = int(width * done / total_);
-        std::fprintf(stderr, "\r[%.*s%*s] %lld/%lld  ETA %.1f s ", filled, "##############################", width - filled,
-                     "", done, total_, eta);
-        if (done == total_) std::fprintf(stderr, "\n");
-    }
-
-private:
-    long long total_;
-    bool enabled_;
-    std::chrono::steady_clock::time_point start_;
-};
-
 int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     using cli::Distribute, cli::FrameRecord, cli::RankExchange;
     cli::Args args(argv);
     if (args.flag("--help") || args.flag("-h")) {
-        if (ranks.rank == 0) std::cout << kUsage;
+        if (ranks.rank == 0) std::cout << kUsage << cli::kLookUsage;
         return 0;
     }
     if (argv.empty()) {   // the same in every tool: the help, as a usage error
-        if (ranks.rank == 0) std::cerr << kUsage;
+        if (ranks.rank == 0) std::cerr << kUsage << cli::kLookUsage;
         return 2;
     }
     const auto iso_text = args.value("--iso");
@@ -120,6 +103,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
     const auto distribute_text = args.value("--distribute");
+    const cli::LookFlags look_flags = cli::LookFlags::take(args);   // issue 17 item 7
     const std::vector<std::string> inputs = args.positional();
     args.finish();
     if (inputs.size() != 1) throw Error("octiso-render", "expected exactly one FILE.oct (octiso-render --help lists every flag)");
@@ -127,6 +111,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     if (!out_path && !depth_path && !normal_path && !debug_pixel) throw Error("-o", "is required (or at least --depth or --normal)");
 
     const Distribute distribute = distribute_text ? cli::parse_distribute(*distribute_text) : Distribute::steps;
+    if (distribute == Distribute::data && look_flags.look.active())
+        throw Error("--distribute", "data traces each slab alone, so shadow, AO and translucent-layer rays cannot cross "
+                                    "into other slabs; use --distribute image or steps with --shadows, --ao or --opacity");
     if (distribute_text && !ranks.mpi_built())
         throw Error("--distribute", "this octiso-render was built without MPI (install libopenmpi-dev and rebuild)");
 
@@ -162,15 +149,23 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         throw Error("--colour", "given " + std::to_string(colour_texts.size()) + " times for " + std::to_string(options.isovalues.size()) +
                                     " isovalue(s) (the k-th --colour colours the k-th isovalue)");
     for (const std::string& c : colour_texts) shading.colours.push_back(parse_colour(c, "--colour"));
+    // Issue 17 item 7: clip planes cut every ray; shadows, AO and opacity shade through LookShader.
+    options.clip_planes = look_flags.clip_planes;
+    const Look& look = look_flags.look;
+    validate_look(look, options.isovalues.size(), shading.model);
     // The colour is shaded after tracing, from the depth and normal AOVs (shading.h), unless the
     // Renderer's own headlight is asked for as it is: that path stays bit for bit the old image.
-    const bool deferred = out_path && (shading.model == ShadingModel::kit || background_text || !colour_texts.empty());
+    const bool deferred = out_path && (shading.model == ShadingModel::kit || background_text || !colour_texts.empty() || look.active());
     RenderOptions trace_options = options;
     if (deferred) trace_options.want_colour = false, trace_options.want_depth = trace_options.want_normal = true;
 
     // Everything about the outputs is checked before the first frame is rendered.
     const auto file = std::make_shared<const OctFile>(OctFile::open(inputs[0]));
     const OctInfo& info = file->info();
+    // CONVENTIONS 2b: --iso is given in real values; the tree and the renderer hold stored ones.
+    const std::vector<double> real_isovalues = options.isovalues;
+    for (double& v : options.isovalues) v = info.value_scale.stored(v);
+    trace_options.isovalues = options.isovalues;
     const std::vector<Camera> cameras = cli::cameras_for(camera_flags, info);
     const bool orbit = camera_flags.orbit.has_value();
     long long first = 0, last = 0;
@@ -228,8 +223,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     for (long long k = first; k <= last; ++k)
         if (const auto r = AnyOctree::step(file, uint32_t(k)).info().value_range)
             data_range = data_range ? std::array<double, 2>{std::min((*data_range)[0], (*r)[0]), std::max((*data_range)[1], (*r)[1])} : *r;
+    if (data_range) data_range = info.value_scale.real_range(*data_range);
     if (data_range)
-        for (const double v : options.isovalues)
+        for (const double v : real_isovalues)
             if (v < (*data_range)[0] || v > (*data_range)[1])
                 throw Error(inputs[0], "isovalue " + cli::number(v) + " lies outside the data range " + cli::number((*data_range)[0]) +
                                            " .. " + cli::number((*data_range)[1]) + (last > first ? " of the rendered steps" : "") +
@@ -271,9 +267,10 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         j.begin_object().key("eye").array(c.eye).key("look").array(c.look).key("up").array(c.up);
         j.field("fov", c.fov_deg).field("width", c.width).field("height", c.height).end_object();
     };
-    Progress progress(root && !split_frames && rank_count == 1 ? (long long)jobs.size() : 0);
+    cli::ProgressLine progress = cli::ProgressLine::on_stderr(root && rank_count == 1 && jobs.size() > 1, 0.0);
     std::optional<Renderer> renderer;
     std::optional<AnyOctree> step_tree;
+    std::optional<LookShader> look_shader;
     long long renderer_step = -1;
     uint64_t ghost_bytes = 0;   // sent with the latest step's ghost exchange
     std::vector<FrameRecord> records;   // this rank's frames
@@ -288,9 +285,11 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             if (split_frames && distribute == Distribute::data)   // the voxels beyond the slab, from their owner
                 rank_options.ghost_plane = ranks.ghost_plane(bricks, [&](uint32_t x) { return step_tree->x_plane(x); }, ghost_bytes);
             renderer.emplace(step_tree->make_renderer(rank_options));
+            if (deferred && look.active()) look_shader.emplace(*step_tree, rank_options, look, shading.model);
             renderer_step = job.step;
         }
-        FrameRecord record{job.index, job.step, rank};
+        FrameRecord record;
+        record.index = job.index, record.step = job.step, record.rank = rank;
         record.bytes_sent = std::exchange(ghost_bytes, 0);
         // One sample: traced by this rank (its tiles or its brick when frames are split), shaded
         // here (deferred shading reads only the pixel's own hit), then assembled on rank 0.
@@ -306,7 +305,8 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             } else {
                 stats = renderer->render(c, f);
             }
-            if (deferred) shade_frame(*step_tree, options.isovalues, c, shading, f);
+            if (deferred && look_shader) record.look.add(look_shader->shade(c, shading, f));
+            else if (deferred) shade_frame(*step_tree, options.isovalues, c, shading, f);
             if (split_frames) {
                 const RankExchange cost = distribute == Distribute::image
                                               ? ranks.gather_tiles(renderer->tile_grid(c.width, c.height), out_path.has_value(),
@@ -349,8 +349,10 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                          (unsigned long long)record.hits, record.threads,
                          spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
                          orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
+        if (look_shader && (root || !split_frames) && (!series || !::isatty(2))) cli::print_look_stats(record.look);
         records.push_back(record);
-        progress.update((long long)records.size());
+        progress.update(double(records.size()), double(jobs.size()),
+                        std::to_string(records.size()) + "/" + std::to_string(jobs.size()) + " frames");
     };
     if (!split_frames && rank_count > 1) {
         // Series across ranks: rank 0 deals the jobs one at a time to whichever rank is free.
@@ -358,6 +360,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     } else {
         for (size_t n = 0; n < jobs.size(); ++n) render_job(n);
     }
+    progress.finish();
     const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     // Rank 0 learns every rank's frames: all of them (steps), or each rank's share of each frame.
     // Sort-last: how much of the file this rank mapped (issue 15: its brick's pages and little
@@ -373,12 +376,13 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     for (const FrameRecord& r : all) total_seconds += r.seconds;
     if (json) {
         j.begin_object().field("file", inputs[0]).field("type", std::string(scalar_type_name(info.type)));
-        j.key("isovalues").array(options.isovalues);
+        j.key("isovalues").array(real_isovalues);
         j.field("width", cameras[0].width).field("height", cameras[0].height);
         j.field("root_finder", std::string(root_finder ? *root_finder : "neubauer")).field("embree", options.use_embree);
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
+        cli::write_look_json(j, look, options.clip_planes);   // issue 17 item 7
         j.field("ranks", rank_count).field("distribute", std::string(distribute_name(distribute)));
         j.key("camera");
         camera_json(cameras[0]);
@@ -391,6 +395,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             j.field("hits", r.hits).field("threads", r.threads);
             if (rank_count > 1) j.field("rank", r.rank);
             if (out_path) j.field("image", name_for(out_path, "-o", r.index));
+            if (look.active()) cli::write_look_stats_json(j, r.look);
             j.key("camera");
             camera_json(*jobs[size_t(r.index - jobs.front().index)].camera);
             if (split_frames) {   // every rank's share of this frame

@@ -11,6 +11,7 @@
 
 #include "octiso/depth_composite.h"
 #include "octiso/frame.h"
+#include "octiso/look.h"
 #include "octiso/tiles.h"
 #include "octiso/volume.h"
 
@@ -31,6 +32,7 @@ struct FrameRecord {
     uint64_t rays = 0, hits = 0, bytes_sent = 0;
     uint64_t file_resident_bytes = 0;   ///< of the rank's mapping of the .oct after its frames (smaps)
     int threads = 0;
+    LookStats look;       ///< secondary rays of the look pass (issue 17 item 7)
     bool wrote = false;   ///< this rank wrote the image (its own step, or rank 0 of a split frame)
 };
 

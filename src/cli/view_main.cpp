@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "octiso/error.h"
 #include "view/server.h"
 #include "view/session.h"
@@ -22,15 +23,15 @@ const char* kUsage =
     "  --iso: the isovalue the page starts at (default: the middle of the data's range)";
 
 int run(std::vector<std::string>& argv) {
-    cli::Args args(argv);
-    if (args.flag("--help") || args.flag("-h")) {
-        std::cout << kUsage << "\n";
-        return 0;
-    }
+    for (const std::string& a : argv)   // --help wins over every other argument
+        if (a == "--help" || a == "-h") {
+            std::cout << kUsage << "\n";
+            return 0;
+        }
+    const cli::Flags args(argv, {"--port", "--host", "--threads", "--iso"}, {});
     const auto port = args.value("--port"), host = args.value("--host"), threads = args.value("--threads");
     const auto iso = args.value("--iso");
     const std::vector<std::string> inputs = args.positional();
-    args.finish();
     if (inputs.size() != 1) throw Error("octiso-view", std::string("expected exactly one FILE.oct\n") + kUsage);
     view::ServerOptions options;
     if (port) options.port = int(cli::parse_int(*port, "--port", 0, 65535));

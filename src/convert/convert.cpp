@@ -4,6 +4,7 @@
 // path because it never has a dense volume.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <optional>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -85,10 +86,45 @@ void fill_report(ConvertReport& r, const ConvertSource& source, const std::strin
     r.steps = n_steps;
     r.iso_range = options.iso_range;
     r.tolerance = options.tolerance;
+    r.value_scale = first.value_scale;
+    r.flipped_axes = first.flipped_axes;
+    if (!first.warning.empty()) r.warnings.push_back(first.warning);
+}
+
+/// The build's options in stored values: --iso-range, --tolerance and --nan-as are given in
+/// real values (CONVENTIONS 2b), the tree and its builder see stored ones.
+BuildOptions stored_options(const BuildOptions& real, const convert_detail::GridOfStep& first) {
+    const ValueScale& s = first.value_scale;
+    BuildOptions o = real;
+    o.value_scale = s;
+    o.flipped_axes = first.flipped_axes;
+    if (s.is_identity()) return o;
+    if (real.iso_range) o.iso_range = s.stored_range(*real.iso_range);
+    o.tolerance = real.tolerance / std::fabs(s.slope);
+    if (real.nan_as) o.nan_as = s.stored(*real.nan_as);
+    if ((o.iso_range && !(std::isfinite((*o.iso_range)[0]) && std::isfinite((*o.iso_range)[1]) && (*o.iso_range)[0] < (*o.iso_range)[1])) ||
+        !std::isfinite(o.tolerance))
+        throw Error(first.source, "--iso-range/--tolerance in real values do not map to a finite stored range (LO < HI) through scl_slope " +
+                                      std::to_string(s.slope));
+    return o;
+}
+
+/// The header of the file: grid and source order of step 0, the options in stored values.
+OctInfo oct_info_of(const convert_detail::GridOfStep& first, const BuildOptions& stored) {
+    OctInfo info;
+    info.type = first.type;
+    info.dims = first.dims;
+    info.placement = first.placement;
+    info.dmax = dmax_for(first.dims);
+    info.iso_range = stored.iso_range;
+    info.tolerance = stored.tolerance;
+    info.value_scale = first.value_scale;
+    info.flipped_axes = first.flipped_axes;
+    return info;
 }
 
 convert_detail::GridOfStep grid_of(const VolumeStream& s) {
-    return {s.source(), s.format(), s.type(), s.dims(), s.placement(), s.bytes()};
+    return {s.source(), s.format(), s.type(), s.dims(), s.placement(), s.bytes(), s.value_scale(), s.flipped_axes(), s.warning()};
 }
 
 /// Out of core (stream_build.h): every step opened as a stream and checked against the first,
@@ -110,16 +146,10 @@ ConvertReport convert_streamed(const ConvertSource& source, const std::string& o
     const uint32_t n_steps = n_files * per_file;
     const convert_detail::StreamPlan plan = convert_detail::plan_stream(first.dims, first.type, options, budget, memory.piece_side, first.source);
 
-    OctInfo info;
-    info.type = first.type;
-    info.dims = first.dims;
-    info.placement = first.placement;
-    info.dmax = dmax_for(first.dims);
-    info.iso_range = options.iso_range;
-    info.tolerance = options.tolerance;
+    BuildOptions opt = stored_options(options, first);
+    const OctInfo info = oct_info_of(first, opt);
 
     ConvertReport r;
-    BuildOptions opt = options;
     OctWriter writer(output, info);
     const uint64_t all_bytes = first.bytes * n_steps;
     const uint64_t layer_voxels = uint64_t(first.dims.x) * first.dims.y;
@@ -230,18 +260,12 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     if (!source.is_synthetic())
         for (uint32_t i = 1; i < n_steps; ++i) check_same_grid(first, source.load(i));
 
-    OctInfo info;
-    info.type = first.type;
-    info.dims = first.dims;
-    info.placement = first.placement;
-    info.dmax = dmax_for(first.dims);
-    info.iso_range = options.iso_range;
-    info.tolerance = options.tolerance;
+    BuildOptions opt = stored_options(options, first);
+    const OctInfo info = oct_info_of(first, opt);
 
     // 2. Build and stream one step at a time; the writer keeps only a temporary file until
     //    finish(), and each step's volume and octree are dropped before the next is opened.
     ConvertReport r;
-    BuildOptions opt = options;
     OctWriter writer(output, info);
     for (uint32_t i = 0; i < n_steps; ++i) {
         LoadedVolume v = i == 0 ? std::move(*step0) : source.load(i);
@@ -256,6 +280,7 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
         add_sizes(r.total, step.sizes);
         tree.append_to(writer);
         r.per_step.push_back(std::move(step));
+        if (memory.on_progress) memory.on_progress(first.bytes * (i + 1), first.bytes * n_steps, first.dims.voxels() * (i + 1));
     }
     writer.finish();
 

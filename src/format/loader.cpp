@@ -4,6 +4,7 @@
 // steps used. Steps are handed out as zero-copy Octree<T> views into the mapping.
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 
@@ -31,6 +32,11 @@ struct StepState {
 };
 
 std::string num(uint64_t v) { return std::to_string(v); }
+std::string g17(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.17g", v);
+    return b;
+}
 
 bool all_zero(const std::byte* p, uint64_t n) {
     for (uint64_t i = 0; i < n; ++i)
@@ -139,6 +145,9 @@ void OctFile::Impl::check_header() {
             std::snprintf(b, sizeof b, "%08x", h.endian_tag);
             return std::string(b);
         }() + "): written on a big-endian machine or damaged");
+    if (h.version == 1)
+        fail("is .oct format version 1, written before value scaling and flipped axes were recorded (a NIfTI "
+             "source may be stored unscaled): convert the source again with octiso-convert");
     if (h.version != format::kFormatVersion)
         fail("unsupported format version (expected " + num(format::kFormatVersion) + ", found " + num(h.version) + ")");
     if (h.header_bytes != sizeof(FileHeader))
@@ -177,6 +186,13 @@ void OctFile::Impl::check_header() {
     }
     if (!std::isfinite(h.tolerance) || !(h.tolerance >= 0)) fail("tolerance must be finite and >= 0");
     info.tolerance = h.tolerance;
+    if (!std::isfinite(h.value_slope) || h.value_slope == 0 || !std::isfinite(h.value_inter))
+        fail("value scale must have a finite, non-zero slope and a finite intercept (found slope " + g17(h.value_slope) +
+             ", intercept " + g17(h.value_inter) + ")");
+    info.value_scale = ValueScale{h.value_slope, h.value_inter};
+    if (h.flipped_axes > kAllAxesFlipped)
+        fail("bad flipped-axes mask (expected 0 .. " + num(kAllAxesFlipped) + ", found " + num(h.flipped_axes) + ")");
+    info.flipped_axes = h.flipped_axes;
     if (h.step_count == 0) fail("holds no time steps");
     info.step_count = h.step_count;
     if (h.reserved0 != 0 || !all_zero(reinterpret_cast<const std::byte*>(h.reserved), sizeof h.reserved))

@@ -19,7 +19,8 @@
 //              |   magic "OCTISO\0\x1a" | version | header_bytes | endian tag |
 //              |   scalar type, dims, dmax, spacing, origin, iso-range,        |
 //              |   tolerance, step count, table offset/count, file bytes,      |
-//              |   XXH3-64 of the table, XXH3-64 of header bytes [0, 248)      |
+//              |   XXH3-64 of the table, value slope/intercept, flipped axes,  |
+//              |   XXH3-64 of header bytes [0, 248)                            |
 //  256         +-------------------------------------------------------------+
 //              | zero padding to the next multiple of 64                      |
 //              +-------------------------------------------------------------+
@@ -54,7 +55,9 @@ static_assert(std::endian::native == std::endian::little,
               ".oct files are mapped without byte swapping: little-endian hosts only");
 
 inline constexpr char kMagic[8] = {'O', 'C', 'T', 'I', 'S', 'O', '\0', '\x1a'};
-inline constexpr uint32_t kFormatVersion = 1;
+/// 2: value slope/intercept and flipped axes (NIfTI scl_slope/scl_inter and negative affine
+/// axes, issue 17). Version 1 files are refused: they may hold NIfTI data stored unscaled.
+inline constexpr uint32_t kFormatVersion = 2;
 inline constexpr uint32_t kEndianTag = 0x01020304u;   ///< reads back as 0x04030201 if swapped
 inline constexpr uint64_t kSectionAlign = 64;
 
@@ -82,7 +85,10 @@ struct FileHeader {
     uint32_t reserved0;               // 132  zero
     uint64_t file_bytes;              // 136  length of the whole file
     uint64_t section_table_checksum;  // 144  XXH3-64 of the table bytes
-    uint8_t reserved[96];             // 152  zero
+    double value_slope;               // 152  real = stored * slope + inter: finite, != 0 (1: identity)
+    double value_inter;               // 160  finite
+    uint8_t flipped_axes;             // 168  bit a: source axis a reversed (0 .. kAllAxesFlipped)
+    uint8_t reserved[79];             // 169  zero
     uint64_t header_checksum;         // 248  XXH3-64 of header bytes [0, 248)
 };
 
@@ -106,7 +112,9 @@ static_assert(offsetof(FileHeader, step_count) == 36 && offsetof(FileHeader, spa
 static_assert(offsetof(FileHeader, origin) == 64 && offsetof(FileHeader, iso_range) == 88);
 static_assert(offsetof(FileHeader, tolerance) == 104 && offsetof(FileHeader, section_table_offset) == 112);
 static_assert(offsetof(FileHeader, section_entry_bytes) == 128 && offsetof(FileHeader, file_bytes) == 136);
-static_assert(offsetof(FileHeader, section_table_checksum) == 144 && offsetof(FileHeader, reserved) == 152);
+static_assert(offsetof(FileHeader, section_table_checksum) == 144 && offsetof(FileHeader, value_slope) == 152);
+static_assert(offsetof(FileHeader, value_inter) == 160 && offsetof(FileHeader, flipped_axes) == 168);
+static_assert(offsetof(FileHeader, reserved) == 169);
 static_assert(offsetof(FileHeader, header_checksum) == 248);
 inline constexpr size_t kHeaderChecksummedBytes = offsetof(FileHeader, header_checksum);
 

@@ -87,6 +87,9 @@ OctWriter::OctWriter(std::string path, const OctInfo& info) : impl_(std::make_un
                             std::isfinite((*info.iso_range)[1])))
         throw Error(p, "iso-range must be finite with LO < HI");
     if (!std::isfinite(info.tolerance) || !(info.tolerance >= 0)) throw Error(p, "tolerance must be finite and >= 0");
+    if (!std::isfinite(info.value_scale.slope) || info.value_scale.slope == 0 || !std::isfinite(info.value_scale.inter))
+        throw Error(p, "value scale must have a finite, non-zero slope and a finite intercept");
+    if (info.flipped_axes > kAllAxesFlipped) throw Error(p, "flipped axes must be a mask of x, y, z");
 
     m.file = std::fopen(m.out.temp_path().c_str(), "wb");
     if (!m.file) throw Error(m.out.temp_path(), std::string("cannot create: ") + std::strerror(errno), ErrorKind::Other);
@@ -212,6 +215,9 @@ void OctWriter::finish() {
         h.iso_range[1] = (*m.info.iso_range)[1];
     }
     h.tolerance = m.info.tolerance;
+    h.value_slope = m.info.value_scale.slope;
+    h.value_inter = m.info.value_scale.inter;
+    h.flipped_axes = m.info.flipped_axes;
     h.section_table_offset = m.pos;
     h.section_count = m.table.size();
     h.section_entry_bytes = sizeof(SectionEntry);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include <zlib.h>
@@ -42,7 +43,11 @@ ScalarType type_of(int datatype) {
     }
 }
 
-const char* kAxis[3] = {"x", "y", "z"};
+std::string g17(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.17g", v);
+    return b;
+}
 
 }  // namespace
 
@@ -78,38 +83,69 @@ NiftiHeader parse_nifti_header(const unsigned char* h, size_t n, const std::stri
     out.scl_slope = f(112, 176);
     out.scl_inter = f(116, 184);
 
-    // 3. Placement (CONVENTIONS 2b): sform, else qform, else pixdim with origin 0.
+    // 3. Value scaling as nibabel's get_slope_inter(): a zero or non-finite slope means none.
+    if (out.scl_slope != 0 && std::isfinite(out.scl_slope)) {
+        if (!std::isfinite(out.scl_inter))
+            throw Error(path, "NIfTI scl_slope is " + g17(out.scl_slope) + " but scl_inter is not finite");
+        out.value_scale = ValueScale{out.scl_slope, out.scl_inter};
+    }
+
+    // 4. The affine, world = A * (i, j, k, 1), as nibabel's get_best_affine() builds it.
     const int qform_code = v2 ? load<int32_t>(h + 344, s) : load<int16_t>(h + 252, s);
     const int sform_code = v2 ? load<int32_t>(h + 348, s) : load<int16_t>(h + 254, s);
     double pixdim[4];
     for (int i = 0; i < 4; ++i) pixdim[i] = v2 ? load<double>(h + 104 + 8 * i, s) : double(load<float>(h + 76 + 4 * i, s));
     out.qfac = pixdim[0] < 0 ? -1 : 1;
+    double A[3][4] = {};
+    const char* source = nullptr;
     if (sform_code > 0) {
-        double row[3][4];
+        source = "sform";
         for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 4; ++c) row[r][c] = f(280 + 16 * size_t(r) + 4 * size_t(c), 400 + 32 * size_t(r) + 8 * size_t(c));
-        for (int r = 0; r < 3 && out.unplaced.empty(); ++r)
-            for (int c = 0; c < 3; ++c)
-                if (r != c && row[r][c] != 0) out.unplaced = "oblique sform";
-        for (int a = 0; a < 3 && out.unplaced.empty(); ++a) {
-            if (row[a][a] < 0) out.unplaced = std::string("sform flips axis ") + kAxis[a];
-            out.placement.spacing[size_t(a)] = row[a][a];
-            out.placement.origin[size_t(a)] = row[a][3];
-        }
+            for (int c = 0; c < 4; ++c) A[r][c] = f(280 + 16 * size_t(r) + 4 * size_t(c), 400 + 32 * size_t(r) + 8 * size_t(c));
     } else if (qform_code > 0) {
+        source = "qform";
         const double b = f(256, 352), c = f(260, 360), d = f(264, 368);
-        if (b != 0 || c != 0 || d != 0) out.unplaced = "qform rotates the grid";
-        else if (pixdim[0] < 0) out.unplaced = "qform flips axis z (qfac -1)";
+        // nibabel's fillpositive: a = sqrt(1 - b^2 - c^2 - d^2), 0 when rounding makes it negative.
+        const double a = std::sqrt(std::max(0.0, 1.0 - (b * b + c * c + d * d)));
+        const double R[3][3] = {{a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
+                                {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
+                                {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
+        const double zoom[3] = {std::abs(pixdim[1]), std::abs(pixdim[2]), std::abs(pixdim[3]) * out.qfac};
+        for (int r = 0; r < 3; ++r) {
+            for (int col = 0; col < 3; ++col) A[r][col] = R[r][col] * zoom[col];
+            A[r][3] = f(268 + 4 * size_t(r), 376 + 8 * size_t(r));
+        }
+    }
+
+    // 5. Placement (CONVENTIONS 2b). Without either code: |pixdim| spacing, origin 0.
+    //    Deviation from nibabel, whose fallback centres the grid (Analyze): CONVENTIONS 2b chose origin 0.
+    const uint64_t extent[3] = {ext[0], ext[1], ext[2]};
+    bool diagonal = source != nullptr;
+    for (int r = 0; r < 3 && diagonal; ++r) {
+        // A quaternion of a 90 or 180 degree turn leaves rounding dust off the diagonal: ignore
+        // entries below 1e-6 of their column's diagonal (a millionth of a voxel at the far side).
+        const double tiny = 1e-6 * std::abs(A[r][r]);
+        if (!(std::abs(A[r][r]) > 0) || !std::isfinite(A[r][r])) diagonal = false;
+        for (int c = 0; c < 3; ++c)
+            if (c != r && !(std::abs(A[c][r]) <= tiny)) diagonal = false;
+    }
+    if (diagonal) {
         for (int a = 0; a < 3; ++a) {
-            out.placement.spacing[size_t(a)] = pixdim[a + 1];
-            out.placement.origin[size_t(a)] = f(268 + 4 * size_t(a), 376 + 8 * size_t(a));
+            const double step = A[a][a];
+            out.placement.spacing[size_t(a)] = std::abs(step);
+            // Reversed: tree index i' = n-1-i, so world = A[a][3] + step*(n-1) + |step|*i'.
+            out.placement.origin[size_t(a)] = step < 0 ? A[a][3] + step * double(extent[a] - 1) : A[a][3];
+            if (step < 0) out.flipped_axes |= uint8_t(1u << a);
         }
     } else {
+        // As vtkNIFTIImageReader places it: pixdim spacing, origin 0, slices reversed for qfac -1
+        // (which makes its qform matrix a rotation); the rotation itself is not applied.
         for (int a = 0; a < 3; ++a) out.placement.spacing[size_t(a)] = std::abs(pixdim[a + 1]);
+        if (out.qfac < 0) out.flipped_axes = 4;
+        if (source)
+            out.warning = std::string("NIfTI ") + source + " is oblique (rotated, sheared or with permuted axes): placed as "
+                          "VTK does (pixdim spacing, origin 0, the rotation ignored)";
     }
-    // Deviation from nibabel (which ignores qfac when the sform places the grid): VTK's reader
-    // reverses the slices of a qfac -1 file, and the whole-file path must keep agreeing with this one.
-    if (out.unplaced.empty() && pixdim[0] < 0) out.unplaced = "qfac -1 (VTK's reader reverses its slices)";
     return out;
 }
 

@@ -54,8 +54,8 @@ std::optional<VolumeFormat> format_from_extension(const std::string& path) {
     return std::nullopt;
 }
 
-// Magic bytes. NIfTI is recognised only to say that it needs its extension: VTK's reader derives
-// header and image names from it.
+// Magic bytes. NIfTI is recognised only to say that it needs its extension (the name decides
+// gzip and the .nii form, as for every NIfTI tool).
 std::optional<VolumeFormat> format_from_magic(const std::string& path) {
     char head[512] = {};
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
@@ -109,7 +109,7 @@ VolumeFormat choose_format(const std::string& path, const RawOptions& options) {
     } else if (!raw_flags) {
         if (auto m = format_from_magic(path)) format = *m;
         if (format == VolumeFormat::nifti)
-            throw Error(path, "looks like NIfTI, but VTK's NIfTI reader needs a .nii or .nii.gz name "
+            throw Error(path, "looks like NIfTI: name it .nii or .nii.gz to read it as NIfTI "
                               "(or give --dims and --type to read it as raw)");
     }
     if (format == VolumeFormat::raw) {
@@ -117,7 +117,11 @@ VolumeFormat choose_format(const std::string& path, const RawOptions& options) {
             throw Error("--dims", "raw input '" + path + "' needs --dims NX,NY,NZ (no other format claims the file)");
         if (!options.type)
             throw Error("--type", "raw input '" + path + "' needs --type u8|i8|u16|i16|u32|i32|f32|f64");
-    } else if (options.endian || options.offset) {
+    }
+    if (options.array && (format == VolumeFormat::raw || format == VolumeFormat::nifti))
+        throw Error("--array", "picks an array of a VTK file (.vti .vtk), and '" + path + "' is read as " +
+                                   std::string(volume_format_name(format)) + ", which holds one");
+    if (format != VolumeFormat::raw && (options.endian || options.offset)) {
         throw Error(options.endian ? "--endian" : "--offset",
                     "applies only to raw input, and '" + path + "' is read as " + std::string(volume_format_name(format)));
     }
@@ -136,17 +140,14 @@ Placement overridden_placement(Placement placement, Dims dims, const std::string
 
 LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
     const VolumeFormat format = choose_format(path, options);
+    // NIfTI goes through the same reader as the out-of-core path (nifti_stream.cpp), not VTK's:
+    // VTK applies neither scl_slope nor the sform's flips, and reverses the slices of qfac -1
+    // files, so one reader for both paths is what keeps their .oct bytes equal (CONVENTIONS 2b).
     LoadedVolume volume = format == VolumeFormat::raw
                               ? read_raw(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
                                          options.offset.value_or(0))
-                              : read_vtk(path, format);
-    if (format == VolumeFormat::nifti) {
-        // CONVENTIONS 2b: an axis-aligned sform/qform places the grid, as the streaming reader
-        // does, so both paths write the same header. Not where VTK reverses the slices (qfac -1)
-        // or the affine flips or rotates an axis: VTK's placement stays for those.
-        const io::NiftiHeader h = io::read_nifti_header(path);
-        if (h.unplaced.empty() && h.qfac > 0) volume.set_placement(h.placement);
-    }
+                          : format == VolumeFormat::nifti ? read_nifti(path)
+                                                          : read_vtk(path, format, options.array);
     volume.set_placement(overridden_placement(volume.placement(), volume.dims(), path, options));
     return volume;
 }

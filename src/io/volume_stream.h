@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -30,6 +31,10 @@ public:
     Dims dims() const { return dims_; }
     const Placement& placement() const { return placement_; }
     void set_placement(const Placement& p) { placement_ = p; }
+    /// As LoadedVolume's: stored-to-real values, source axes reversed as read, a reader's note.
+    const ValueScale& value_scale() const { return value_scale_; }
+    uint8_t flipped_axes() const { return flipped_axes_; }
+    const std::string& warning() const { return warning_; }
     const std::string& source() const { return source_; }
     VolumeFormat format() const { return format_; }
     uint64_t layer_bytes() const { return uint64_t(dims_.x) * dims_.y * scalar_type_bytes(type_); }
@@ -60,6 +65,11 @@ public:
 
 protected:
     void set_time_steps(uint32_t n) { time_steps_ = n; }
+    void set_source_order(const ValueScale& scale, uint8_t flipped, std::string warning) {
+        value_scale_ = scale;
+        flipped_axes_ = flipped;
+        warning_ = std::move(warning);
+    }
     /// The next `bytes` voxel bytes of the file in native byte order.
     virtual void read_bytes(uint64_t bytes, std::byte* dst) = 0;
 
@@ -67,6 +77,9 @@ private:
     ScalarType type_;
     Dims dims_;
     Placement placement_;
+    ValueScale value_scale_;
+    uint8_t flipped_axes_ = 0;
+    std::string warning_;
     std::string source_;
     VolumeFormat format_;
     uint32_t next_layer_ = 0;
@@ -78,10 +91,16 @@ private:
 std::unique_ptr<VolumeStream> open_raw_stream(const std::string& path, Dims dims, ScalarType type, Endian endian,
                                               uint64_t offset);
 
-/// NIfTI-1/-2, .nii or .nii.gz (nifti_stream.cpp): header checked and parsed, placement from an
-/// axis-aligned sform/qform (CONVENTIONS 2b). Refused with a message for now: a flipped or oblique
-/// affine, and scl_slope/scl_inter that change values.
+/// NIfTI-1/-2, .nii or .nii.gz (nifti_stream.cpp): header checked and parsed, placed as nibabel
+/// reads it (CONVENTIONS 2b): axes with a negative affine entry are reversed as they are read
+/// (a reversed z holds one volume in memory), scl_slope/scl_inter become value_scale(), an
+/// oblique affine is placed as VTK does and named in warning().
 std::unique_ptr<VolumeStream> open_nifti_stream(const std::string& path);
+
+/// The whole of a 3-D NIfTI file through open_nifti_stream() into memory: the in-memory
+/// converter's reader, so both paths read NIfTI with the same code. Throws Error(path, ...) for
+/// a 4-D file (convert() makes those a series through the stream).
+LoadedVolume read_nifti(const std::string& path);
 
 /// Whether open_volume_stream() can stream `path` (raw and NIfTI input); other formats are read
 /// whole by open_volume().
@@ -107,6 +126,30 @@ inline void swap_scalars_in_place(std::byte* p, uint64_t bytes, size_t scalar_by
     if (scalar_bytes == 2) swap_all(uint16_t{});
     else if (scalar_bytes == 4) swap_all(uint32_t{});
     else if (scalar_bytes == 8) swap_all(uint64_t{});
+}
+
+/// Reverses the axes in `mask` (bit a: axis a = x, y, z) of `layers` x-fastest layers of a
+/// `dims` grid (dims.z is ignored: z is reversed over the `layers` given), in place. The NIfTI
+/// reader turns reversed file axes round with it, the writers give the file's order back.
+inline void reverse_axes_in_place(std::byte* p, Dims dims, uint32_t layers, size_t scalar_bytes, uint8_t mask) {
+    const size_t row = size_t(dims.x) * scalar_bytes, layer = row * dims.y;
+    if (mask & 4)
+        for (uint32_t k = 0; k < layers / 2; ++k) std::swap_ranges(p + k * layer, p + (k + 1) * layer, p + (layers - 1 - k) * layer);
+    std::byte tmp[8];
+    for (uint32_t k = 0; k < layers && (mask & 3); ++k) {
+        std::byte* l = p + k * layer;
+        if (mask & 2)
+            for (uint32_t j = 0; j < dims.y / 2; ++j) std::swap_ranges(l + j * row, l + (j + 1) * row, l + (dims.y - 1 - j) * row);
+        if (mask & 1)
+            for (uint32_t j = 0; j < dims.y; ++j)
+                for (uint32_t i = 0; i < dims.x / 2; ++i) {
+                    std::byte* a = l + j * row + i * scalar_bytes;
+                    std::byte* b = l + j * row + (dims.x - 1 - i) * scalar_bytes;
+                    std::memcpy(tmp, a, scalar_bytes);
+                    std::memcpy(a, b, scalar_bytes);
+                    std::memcpy(b, tmp, scalar_bytes);
+                }
+    }
 }
 
 }  // namespace octiso

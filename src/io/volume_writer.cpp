@@ -13,12 +13,15 @@
 
 #include <vtkDataArray.h>
 #include <vtkImageData.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNIFTIImageWriter.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
 #include <vtkType.h>
 #include <vtkXMLImageDataWriter.h>
 
+#include "io/volume_stream.h"
 #include "octiso/error.h"
 #include "util/atomic_output.h"
 
@@ -62,17 +65,12 @@ std::string g17(double v) {
     return buf;
 }
 
+vtkSmartPointer<vtkImageData> image_over(ScalarType type, Dims dims, std::span<const std::byte> data);
+
 void write_vti(const std::string& path, ScalarType type, Dims dims, const Placement& p, std::span<const std::byte> data) {
-    vtkNew<vtkImageData> image;
-    image->SetDimensions(int(dims.x), int(dims.y), int(dims.z));
+    vtkSmartPointer<vtkImageData> image = image_over(type, dims, data);
     image->SetSpacing(p.spacing[0], p.spacing[1], p.spacing[2]);
     image->SetOrigin(p.origin[0], p.origin[1], p.origin[2]);
-    vtkSmartPointer<vtkDataArray> array = vtkSmartPointer<vtkDataArray>::Take(vtkDataArray::CreateDataArray(vtk_type_of(type)));
-    array->SetNumberOfComponents(1);
-    array->SetName("scalars");
-    // The writer only reads the array; save = 1: VTK never frees memory it does not own.
-    array->SetVoidArray(const_cast<std::byte*>(data.data()), vtkIdType(dims.voxels()), 1);
-    image->GetPointData()->SetScalars(array);
     AtomicOutput out(path);
     vtkNew<vtkXMLImageDataWriter> writer;
     writer->SetFileName(out.temp_path().c_str());
@@ -80,6 +78,68 @@ void write_vti(const std::string& path, ScalarType type, Dims dims, const Placem
     writer->SetDataModeToAppended();
     writer->SetCompressorTypeToZLib();
     if (writer->Write() != 1 || writer->GetErrorCode() != 0) throw Error(path, "VTK's image writer failed", ErrorKind::Other);
+    out.commit();
+}
+
+/// vtkImageData over `data` without a copy (the writers only read it).
+vtkSmartPointer<vtkImageData> image_over(ScalarType type, Dims dims, std::span<const std::byte> data) {
+    auto image = vtkSmartPointer<vtkImageData>::New();
+    image->SetDimensions(int(dims.x), int(dims.y), int(dims.z));
+    vtkSmartPointer<vtkDataArray> array = vtkSmartPointer<vtkDataArray>::Take(vtkDataArray::CreateDataArray(vtk_type_of(type)));
+    array->SetNumberOfComponents(1);
+    array->SetName("scalars");
+    // save = 1: VTK never frees memory it does not own.
+    array->SetVoidArray(const_cast<std::byte*>(data.data()), vtkIdType(dims.voxels()), 1);
+    image->GetPointData()->SetScalars(array);
+    return image;
+}
+
+/// NIfTI-1 through vtkNIFTIImageWriter, in the source file's order: voxel (i,j,k) of the file
+/// sits at srow * (i,j,k,1) with srow = diag(+-spacing) and, on a reversed axis, the far end of
+/// the tree's box as its translation, which is what the reader turned round (CONVENTIONS 2b).
+void write_nifti(const std::string& path, ScalarType type, Dims dims, const Placement& p, std::span<const std::byte> data,
+                 const ValueScale& scale, uint8_t flipped) {
+    std::vector<std::byte> file_order;
+    if (flipped) {
+        file_order.assign(data.begin(), data.end());
+        reverse_axes_in_place(file_order.data(), dims, dims.z, scalar_type_bytes(type), flipped);
+        data = file_order;
+    }
+    vtkSmartPointer<vtkImageData> image = image_over(type, dims, data);
+    // The writer scales the sform's columns by the spacing and keeps the image origin out of it.
+    image->SetSpacing(p.spacing[0], p.spacing[1], p.spacing[2]);
+    image->SetOrigin(0, 0, 0);
+    const uint32_t n[3] = {dims.x, dims.y, dims.z};
+    vtkNew<vtkMatrix4x4> sform;
+    for (int a = 0; a < 3; ++a) {
+        const bool reversed = flipped & (1u << a);
+        sform->SetElement(a, a, reversed ? -1.0 : 1.0);
+        sform->SetElement(a, 3, reversed ? p.origin[size_t(a)] + p.spacing[size_t(a)] * double(n[a] - 1) : p.origin[size_t(a)]);
+    }
+    AtomicOutput out(path);
+    // VTK's writer picks gzip from the name it is given: keep the user's ending on the temporary.
+    const std::string temp = out.temp_path() + (ends_with(path, ".gz") ? ".nii.gz" : ".nii");
+    vtkNew<vtkNIFTIImageWriter> writer;
+    writer->SetFileName(temp.c_str());
+    writer->SetInputData(image);
+    writer->SetSFormMatrix(sform);
+    if (!flipped) {
+        // A qform too (a rotation, so only without reversed axes): readers that prefer it agree.
+        vtkNew<vtkMatrix4x4> qform;
+        for (int a = 0; a < 3; ++a) qform->SetElement(a, 3, p.origin[size_t(a)]);
+        writer->SetQFormMatrix(qform);
+    }
+    if (!scale.is_identity()) {
+        writer->SetRescaleSlope(scale.slope);
+        writer->SetRescaleIntercept(scale.inter);
+    }
+    writer->SetDescription("octiso-info --extract");
+    writer->Write();
+    const bool ok = writer->GetErrorCode() == 0;
+    if (!ok || std::rename(temp.c_str(), out.temp_path().c_str()) != 0) {
+        std::remove(temp.c_str());
+        throw Error(path, "VTK's NIfTI writer failed", ErrorKind::Other);
+    }
     out.commit();
 }
 
@@ -99,18 +159,25 @@ void write_nrrd(const std::string& path, ScalarType type, Dims dims, const Place
 }  // namespace
 
 bool is_volume_file_format(const std::string& path) {
-    return ends_with(path, ".vti") || ends_with(path, ".nrrd") || ends_with(path, ".raw");
+    return ends_with(path, ".vti") || ends_with(path, ".nrrd") || ends_with(path, ".raw") || ends_with(path, ".nii") ||
+           ends_with(path, ".nii.gz");
 }
 
 void write_volume_file(const std::string& path, ScalarType type, Dims dims, const Placement& placement,
-                       std::span<const std::byte> data) {
+                       std::span<const std::byte> data, const ValueScale& scale, uint8_t flipped_axes) {
     if (data.size() != checked_volume_bytes(dims, type, path))
         throw Error(path, "the data is " + std::to_string(data.size()) + " bytes, the grid needs " +
                               std::to_string(checked_volume_bytes(dims, type, path)), ErrorKind::Other);
     if (ends_with(path, ".vti")) return write_vti(path, type, dims, placement, data);
     if (ends_with(path, ".nrrd")) return write_nrrd(path, type, dims, placement, data);
-    if (ends_with(path, ".raw")) return write_file_atomically(path, data.data(), data.size());
-    throw Error(path, "no volume format for this extension (.vti, .nrrd or .raw)");
+    if (ends_with(path, ".nii") || ends_with(path, ".nii.gz")) return write_nifti(path, type, dims, placement, data, scale, flipped_axes);
+    if (ends_with(path, ".raw")) {
+        if (!flipped_axes) return write_file_atomically(path, data.data(), data.size());
+        std::vector<std::byte> file_order(data.begin(), data.end());
+        reverse_axes_in_place(file_order.data(), dims, dims.z, scalar_type_bytes(type), flipped_axes);
+        return write_file_atomically(path, file_order.data(), file_order.size());
+    }
+    throw Error(path, "no volume format for this extension (.vti, .nrrd, .nii, .nii.gz or .raw)");
 }
 
 }  // namespace octiso

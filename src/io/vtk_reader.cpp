@@ -1,6 +1,8 @@
 // read_vtk(): NIfTI, VTK XML image data, legacy VTK structured points, MetaImage and NRRD through
 // VTK's own readers. VTK reports failures through events and its output window rather than
 // exceptions, so every read runs with an error observer and a silent, capturing output window,
+// (open_volume() reads NIfTI with read_nifti() instead, nifti_stream.cpp: CONVENTIONS 2b's
+// scaling and flips; NIfTI stays here for callers that ask for VTK's own reading),
 // and the output is checked (dims, one component, array length) before anyone trusts it. The
 // scalar array stays alive inside the LoadedVolume: no copy of the voxels is made.
 #include <iostream>
@@ -160,7 +162,7 @@ vtkSmartPointer<vtkAlgorithm> make_reader(octiso::VolumeFormat format, const std
 
 namespace octiso {
 
-LoadedVolume read_vtk(const std::string& path, VolumeFormat format) {
+LoadedVolume read_vtk(const std::string& path, VolumeFormat format, const std::optional<std::string>& array) {
     io::check_input_file(path);
     io::check_declared_size(path, format);   // before VTK: bad datatypes crash it, short data is zero-filled
     silence_vtk();
@@ -172,6 +174,7 @@ LoadedVolume read_vtk(const std::string& path, VolumeFormat format) {
         auto* legacy = static_cast<vtkStructuredPointsReader*>(reader.GetPointer());
         if (!legacy->IsFileStructuredPoints())
             throw Error(path, what + "not a legacy VTK STRUCTURED_POINTS file");
+        if (array) legacy->ReadAllScalarsOn();   // else only the first SCALARS block is read
     }
 
     // 1. Run the reader with both error channels captured.
@@ -201,8 +204,23 @@ LoadedVolume read_vtk(const std::string& path, VolumeFormat format) {
     // 2. The output must be one complete single-component image.
     vtkImageData* image = vtkImageData::SafeDownCast(reader->GetOutputDataObject(0));
     if (!image) throw Error(path, what + "no image data in the file");
-    vtkDataArray* scalars = image->GetPointData()->GetScalars();
-    if (!scalars && image->GetPointData()->GetNumberOfArrays() > 0) scalars = image->GetPointData()->GetArray(0);
+    vtkPointData* point_data = image->GetPointData();
+    vtkDataArray* scalars = nullptr;
+    if (array) {
+        scalars = point_data->GetArray(array->c_str());
+        if (!scalars) {
+            std::string names;
+            for (int i = 0; i < point_data->GetNumberOfArrays(); ++i) {
+                const char* name = point_data->GetArrayName(i);
+                names += std::string(i ? ", " : "") + "'" + (name ? name : "") + "'";
+            }
+            throw Error(path, "has no point data array '" + *array + "' (--array; arrays in the file: " +
+                                  (names.empty() ? std::string("none") : names) + ")");
+        }
+    } else {
+        scalars = point_data->GetScalars();
+        if (!scalars && point_data->GetNumberOfArrays() > 0) scalars = point_data->GetArray(0);
+    }
     if (!scalars) throw Error(path, what + "no point data array (cell data is not supported)");
     if (scalars->GetNumberOfComponents() != 1) {
         // VTK's NRRD reader takes a fastest axis of 9 or fewer samples for vector components.

@@ -15,9 +15,15 @@
 namespace octiso {
 
 /// World-space ray: origin and unit direction (CONVENTIONS 2). Components may be +-0.
+/// [t_min, t_max] is the piece of the ray a tracer may hit (world distance, closed); the default
+/// [0, +inf] is a primary ray as CONVENTIONS 2b defines it. Secondary rays start at t_min > 0
+/// (render/secondary.h) and clip planes narrow the interval before traversal (render/clip.h);
+/// t_min > t_max is an empty ray, never hit.
 struct Ray {
     std::array<double, 3> origin{};
     std::array<double, 3> dir{};
+    double t_min = 0.0;
+    double t_max = std::numeric_limits<double>::infinity();
 };
 
 /// The same ray in index space: p_index(t) = origin + t * dir, t the world distance.
@@ -93,6 +99,19 @@ OCTISO_ALWAYS_INLINE BoxClip clip_to_box(const IndexRay& ray, const std::array<d
     }
     if (!std::isfinite(t_in) || !std::isfinite(t_out) || !(t_in <= t_out)) return clip;   // dir == 0: no ray
     clip.t_in = t_in, clip.t_out = t_out;
+    return clip;
+}
+
+/// clip_to_box on the ray's own interval [ray_world.t_min, ray_world.t_max] (math/ray.h, Ray).
+/// For the default interval it is clip_to_box(ray, box_hi) bit for bit: t_min 0 is the old lower
+/// bound and min(t_out, +inf) == t_out. A t_max inside the box ends the piece there, and that end
+/// is closed like the data exit (the cell holding it owns t_max, CONVENTIONS 2b).
+OCTISO_ALWAYS_INLINE BoxClip clip_to_box(const IndexRay& ray, const std::array<double, 3>& box_hi, const Ray& ray_world) {
+    if (!(ray_world.t_min <= ray_world.t_max)) return {};   // empty, or NaN bounds
+    BoxClip clip = clip_to_box(ray, box_hi, ray_world.t_min);
+    if (clip.empty()) return clip;
+    if (ray_world.t_max < clip.t_out) clip.t_out = ray_world.t_max;
+    if (!(clip.t_in <= clip.t_out)) return {};
     return clip;
 }
 

@@ -20,7 +20,7 @@ RefHit trace_reference(const VolumeView<T>& volume, const Placement& placement, 
     const std::array<double, 3> box_hi{double(n_cells[0]), double(n_cells[1]), double(n_cells[2])};
 
     const IndexRay ray = index_from_world(ray_world, placement);
-    const BoxClip clip = clip_to_box(ray, box_hi);
+    const BoxClip clip = clip_to_box(ray, box_hi, ray_world);   // the ray's [t_min, t_max]
     if (clip.empty()) return hit;
 
     int64_t cell[3];

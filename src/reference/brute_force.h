@@ -23,7 +23,7 @@ struct RefHit {
     bool is_hit() const { return t < std::numeric_limits<double>::infinity(); }
 };
 
-/// First isosurface hit with t >= 0 of `ray_world` (unit direction) in the volume placed by
+/// First isosurface hit with t in [ray_world.t_min, ray_world.t_max] (default [0, +inf]) of `ray_world` (unit direction) in the volume placed by
 /// `placement`, under the hit policies of CONVENTIONS 2b: each cell owns [t_in, t_out) of the ray,
 /// the last cell before the ray leaves the data its closed piece; cells with a non-finite corner
 /// are skipped. A volume with an extent < 2 has no cells and is never hit. Thread-safe.

@@ -61,13 +61,14 @@ struct RayState {
     bool want_normal = false;
     TraceHit hit;
 
-    /// Starts `ray_world` in `scene`: returns the piece inside the data box, empty on a miss.
+    /// Starts `ray_world` in `scene`: returns the piece of its interval [t_min, t_max] inside the
+    /// data box, empty on a miss.
     BoxClip start(const CellWalkScene& scene, const Ray& ray_world, bool normal) {
         world_dir = ray_world.dir;
         want_normal = normal;
         if (!scene.has_cells) return {};
         ray = index_from_world(ray_world, scene.placement);
-        const BoxClip clip = clip_to_box(ray, scene.box_hi);
+        const BoxClip clip = clip_to_box(ray, scene.box_hi, ray_world);
         t_exit = clip.t_out;
         return clip;
     }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "octiso/error.h"
+#include "render/clip.h"
 #include "render/pinhole_camera.h"
 #include "render/roots.h"
 #include "render/traverse.h"
@@ -126,7 +127,8 @@ PixelTrace trace_pixel(const Octree<T>& tree, const Placement& placement, const 
     PixelTrace out;
     out.x = x, out.y = y, out.width = camera.width, out.height = camera.height;
     out.isovalues = options.isovalues;
-    const Ray ray = PinholeCamera(camera).ray(x, y);
+    Ray ray = PinholeCamera(camera).ray(x, y);
+    clip_ray(options.clip_planes, ray);   // the interval the frame traces (render/clip.h)
     out.origin = ray.origin, out.dir = ray.dir;
     dispatch_root_finder(options.root_finder, options.iterations, [&](const auto& finder) {
         using Finder = std::decay_t<decltype(finder)>;

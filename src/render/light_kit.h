@@ -49,12 +49,23 @@ inline std::array<Vec3, kKitLights> light_directions(const LightKit& kit, const 
     return out;
 }
 
+/// How much of the kit's light reaches a hit (issue 17 item 7, api/look.cpp): `key`, the key
+/// light's transmittance along its shadow ray; `ambient`, the unoccluded fraction of the
+/// hemisphere, which scales the ambient term and the broad fill light. 1, 1: fully lit, and
+/// the colour is bit for bit that of before (x * 1.0 == x).
+struct KitVisibility {
+    double key = 1.0, ambient = 1.0;
+};
+
+/// The key light: lights[0], the one shadow rays aim at.
+inline constexpr size_t kKeyLight = 0;
+
 /// Linear RGB of a hit with unit `normal` facing the ray, seen along unit `dir`, albedo `albedo`.
 inline std::array<double, 3> shade_light_kit(const LightKit& kit, const std::array<Vec3, kKitLights>& to_light, const Vec3& normal,
-                                             const Vec3& dir, const float albedo[3]) {
-    double diffuse = kit.ambient, highlight = 0;
+                                             const Vec3& dir, const float albedo[3], const KitVisibility& visible = {}) {
+    double diffuse = kit.ambient * visible.ambient, highlight = 0;
     for (size_t i = 0; i < to_light.size(); ++i) {
-        const double intensity = kit.lights[i].intensity;
+        const double intensity = kit.lights[i].intensity * (i == kKeyLight ? visible.key : visible.ambient);
         const double nl = vec_dot(normal, to_light[i]);
         if (!(nl > 0)) continue;   // the light is behind the surface (NaN-safe)
         diffuse += intensity * nl;

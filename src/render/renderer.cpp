@@ -14,6 +14,7 @@
 
 #include "octiso/error.h"
 #include "octiso/render.h"
+#include "render/clip.h"
 #include "render/pinhole_camera.h"
 #include "render/shade.h"
 #include "render/tile_loop.h"
@@ -37,6 +38,12 @@ void validate_options(const RenderOptions& options, const RenderLimits& limits) 
                                          "): the data there was clamped when " + limits.source + " was converted");
     }
     if (options.tile_size < 0) throw Error("tile_size", "must not be negative");
+    for (const ClipPlane& c : options.clip_planes) {
+        const auto& n = c.normal;
+        if (!std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2]) || !std::isfinite(c.d) ||
+            (n[0] == 0 && n[1] == 0 && n[2] == 0))
+            throw Error("--clip", "a clip plane needs a finite, non-zero normal and a finite offset (NX,NY,NZ,D)");
+    }
 }
 
 struct Renderer::Impl {
@@ -73,6 +80,7 @@ void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, cons
     constexpr int kPacket = EmbreeVolumeScene::kPacket;
     const bool want_normal = options.want_colour || options.want_normal;
     const bool packets = options.traversal == Traversal::packets;
+    const std::span<const ClipPlane> clip_planes = options.clip_planes;
     const SrgbTable& to_srgb8 = SrgbTable::instance();
     const int W = frame.width;
     Ray rays[kPacket];
@@ -84,6 +92,7 @@ void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, cons
             for (int py = y0; py < std::min(y0 + kPacketH, rect.y1); ++py)
                 for (int px = x0; px < std::min(x0 + kPacketW, rect.x1); ++px) {
                     rays[count] = pinhole.ray(px, py);
+                    if (!clip_planes.empty()) clip_ray(clip_planes, rays[count]);
                     pixel[count++] = size_t(py) * W + size_t(px);
                 }
             if (scene) scene->intersect_packet(rays, count, want_normal, traced);

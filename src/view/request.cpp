@@ -57,7 +57,7 @@ FrameRequest parse_frame_request(const QueryParameters& parameters, uint32_t ste
         throw Error("query", "too many parameters (at most " + std::to_string(kMaxParameters) + ")");
     // Each known name once; the bit says it was seen, so a repeat is caught (a proxy or a hand-
     // made URL could send "iso=1&iso=2", and which one wins would be a guess).
-    enum : unsigned { kIso = 1, kAz = 2, kEl = 4, kZoom = 8, kW = 16, kH = 32, kStep = 64, kSeq = 128 };
+    enum : unsigned { kIso = 1, kAz = 2, kEl = 4, kZoom = 8, kW = 16, kH = 32, kStep = 64, kSeq = 128, kEnc = 256 };
     unsigned seen = 0;
     FrameRequest r;
     for (const auto& [name, value] : parameters) {
@@ -70,6 +70,7 @@ FrameRequest parse_frame_request(const QueryParameters& parameters, uint32_t ste
         else if (name == "h") bit = kH;
         else if (name == "step") bit = kStep;
         else if (name == "seq") bit = kSeq;
+        else if (name == "enc") bit = kEnc;
         else throw Error(name.size() <= kMaxValueLength ? name : name.substr(0, kMaxValueLength) + "...", "unknown parameter");
         if (seen & bit) throw Error(name, "given more than once");
         seen |= bit;
@@ -85,6 +86,11 @@ FrameRequest parse_frame_request(const QueryParameters& parameters, uint32_t ste
             case kStep:
                 if (step_count == 0) throw Error("step", "the file has no steps");
                 r.step = uint32_t(to_integer(name, value, 0, (long long)step_count - 1));
+                break;
+            case kEnc:
+                if (value == "png") r.encoding = FrameEncoding::png;
+                else if (value == "rgba") r.encoding = FrameEncoding::rgba;
+                else throw Error(name, "expected png or rgba, found '" + value + "'");
                 break;
             default: r.seq = to_counter(name, value); break;
         }

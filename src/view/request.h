@@ -20,6 +20,14 @@ inline constexpr size_t kMaxValueLength = 64;               ///< characters of o
 inline constexpr double kMaxElevationDeg = 89.0;            ///< |elevation| < 90 keeps z-up defined
 inline constexpr double kMinZoom = 0.05, kMaxZoom = 50.0;
 
+/// How a frame's pixels travel. png: lossless and compact (OpenImageIO, zlib level 1; 105 KB for
+/// ch2better at 512^2), for a page on another machine; rgba: the tile loop's colour as raw 8-bit
+/// RGBA rows (alpha 255, 1 MB at 512^2), which the page wraps as ImageData without decoding. On
+/// loopback rgba is the faster one: at 512^2 the PNG encode took 16-25 ms p50 and Chromium's
+/// decode 5-7 ms, the raw body arrives and is wrapped in about 4 ms (bench/interactive_browser.py
+/// --encodings rgba,png, BENCHMARKS.md viewer section).
+enum class FrameEncoding { png, rgba };
+
 /// One frame asked for: the camera of orbit_camera(dims, placement, width, height, azimuth_deg,
 /// elevation_deg, zoom) and the isovalue `iso` of series step `step`.
 /// Invariants after parse_frame_request: iso, azimuth_deg finite; |elevation_deg| <= kMaxElevationDeg;
@@ -31,12 +39,14 @@ struct FrameRequest {
     int width = 512, height = 512;
     uint32_t step = 0;
     uint64_t seq = 0;   ///< the client's counter, echoed back so it can drop replies older than shown
+    FrameEncoding encoding = FrameEncoding::png;
 };
 
 using QueryParameters = std::vector<std::pair<std::string, std::string>>;
 
 /// Parses the (already percent-decoded) name/value pairs of a /frame query for a file of
-/// `step_count` steps. iso, az, el, w, h are required; zoom (1), step (0), seq (0) optional.
+/// `step_count` steps. iso, az, el, w, h are required; zoom (1), step (0), seq (0) and
+/// enc (png; or rgba) optional.
 /// Throws Error(parameter name, problem) for a missing, repeated, unknown, malformed or out-of-
 /// bounds parameter. Numbers are plain decimal (no sign '+', no spaces, no inf/nan, no hex).
 FrameRequest parse_frame_request(const QueryParameters& parameters, uint32_t step_count);

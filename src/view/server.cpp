@@ -56,7 +56,14 @@ struct ViewServer::Impl {
             return text_reply(res, 400, e.what());
         }
         try {
-            std::optional<FrameReply> reply = frames.run(request, [&](const FrameRequest& r) { return session.render(r); });
+            // Per-phase timers (the page and bench/interactive_browser.py show them): how long
+            // this request waited behind another render, and the whole handler up to the reply.
+            const auto entered = std::chrono::steady_clock::now();
+            double wait_seconds = 0;
+            std::optional<FrameReply> reply = frames.run(request, [&](const FrameRequest& r) {
+                wait_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - entered).count();
+                return session.render(r);
+            });
             res.set_header("Cache-Control", "no-store");
             res.set_header("X-Octiso-Seq", std::to_string(request.seq));
             if (!reply) {
@@ -64,13 +71,17 @@ struct ViewServer::Impl {
                 res.set_header("X-Octiso-Superseded", "1");
                 return;
             }
-            char stats[256];
-            std::snprintf(stats, sizeof stats, "seconds=%.6f;encode=%.6f;rays=%llu;hits=%llu;threads=%d;mrays=%.3f",
-                          reply->stats.seconds, reply->encode_seconds, (unsigned long long)reply->stats.rays,
-                          (unsigned long long)reply->stats.hits, reply->stats.threads, reply->stats.mrays_per_second());
+            char stats[320];
+            std::snprintf(stats, sizeof stats,
+                          "seconds=%.6f;encode=%.6f;wait=%.6f;server=%.6f;rays=%llu;hits=%llu;threads=%d;mrays=%.3f",
+                          reply->stats.seconds, reply->encode_seconds, wait_seconds,
+                          std::chrono::duration<double>(std::chrono::steady_clock::now() - entered).count(),
+                          (unsigned long long)reply->stats.rays, (unsigned long long)reply->stats.hits, reply->stats.threads,
+                          reply->stats.mrays_per_second());
             res.set_header("X-Octiso-Stats", stats);
             res.set_header("X-Octiso-Command", percent_encode(reply->command));
-            res.set_content(std::move(reply->png), "image/png");
+            res.set_header("X-Octiso-Size", std::to_string(reply->camera.width) + "x" + std::to_string(reply->camera.height));
+            res.set_content(std::move(reply->body), reply->content_type);
         } catch (const Error& e) {
             text_reply(res, e.kind() == ErrorKind::BadInput ? 422 : 500, e.what());
         } catch (const std::exception& e) {

@@ -1,12 +1,14 @@
 // ViewServer: octiso-view's HTTP face (cpp-httplib). Exactly three routes, all GET:
 //   /       the page (web/viewer.html, compiled into the binary; no file is ever read for a request)
 //   /info   ViewSession::info_json()
-//   /frame  ?iso=&az=&el=&zoom=&w=&h=&step=&seq=  (request.h) -> image/png, or 204 with
-//           X-Octiso-Superseded: 1 when a newer frame request arrived while this one waited
+//   /frame  ?iso=&az=&el=&zoom=&w=&h=&step=&seq=&enc=  (request.h) -> image/png (enc=png, the
+//           default) or raw RGBA rows as application/octet-stream (enc=rgba; X-Octiso-Size WxH),
+//           or 204 with X-Octiso-Superseded: 1 when a newer frame request arrived while this one waited
 // Anything else is 404; a malformed /frame is 400 with a one-line text reason; a render error
 // (an isovalue outside the file's iso-range) 422; over the request-rate bound 429. Requests are
-// bounded in size by cpp-httplib (URI, headers) and here (no bodies). Frame statistics and the
-// reproducing command ride in X-Octiso-* headers (percent-encoded where they carry text).
+// bounded in size by cpp-httplib (URI, headers) and here (no bodies). Frame statistics (render,
+// encode, wait behind another render, whole handler, in seconds) and the reproducing command
+// ride in X-Octiso-* headers (percent-encoded where they carry text).
 #pragma once
 
 #include <functional>

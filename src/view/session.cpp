@@ -13,6 +13,7 @@
 #include "octiso/render.h"
 #include "octiso/volume.h"
 #include "view/png.h"
+#include "view/rgba.h"
 
 namespace octiso::view {
 namespace {
@@ -136,6 +137,9 @@ FrameReply ViewSession::render(const FrameRequest& request) {
     RenderOptions options;
     options.isovalues = {request.iso};
     options.threads = threads_;
+    // The kernel directly, without Embree's dispatch: the same pixels (RenderPaths.
+    // EmbreeAndDirectGiveIdenticalFrames), 1-5 % less per frame (BENCHMARKS.md, packets).
+    options.use_embree = false;
     std::unique_ptr<Renderer>& renderer = renderers_[request.step];
     if (!renderer) renderer = std::make_unique<Renderer>(AnyOctree::step(file_, request.step).make_renderer(options));
     else renderer->set_options(options);   // validates the isovalue against the file's iso-range
@@ -143,7 +147,13 @@ FrameReply ViewSession::render(const FrameRequest& request) {
     reply.camera = camera_for(request);
     reply.stats = renderer->render(reply.camera, frame_);
     const auto t0 = std::chrono::steady_clock::now();
-    reply.png = encode_png(frame_);
+    if (request.encoding == FrameEncoding::rgba) {
+        reply.body = rgba_bytes(frame_);
+        reply.content_type = "application/octet-stream";
+    } else {
+        reply.body = encode_png(frame_);
+        reply.content_type = "image/png";
+    }
     reply.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     reply.command = render_command(path_, reply.camera, request.iso, request.step, step_count());
     return reply;

@@ -1,7 +1,8 @@
 // ViewSession: what octiso-view serves, apart from HTTP: the opened .oct file, one persistent
 // Renderer per series step (built on first use and kept), the /info description (dims, value
-// range, histogram, steps) and, for each frame, the PNG with its camera, statistics and the
-// octiso-render command line that reproduces it. Coalescing and routes are server.h.
+// range, histogram, steps) and, for each frame, its pixels (PNG or raw RGBA) with its camera,
+// statistics and the octiso-render command line that reproduces it. Coalescing and routes are
+// server.h.
 #pragma once
 
 #include <array>
@@ -21,7 +22,8 @@ namespace octiso::view {
 
 /// One rendered frame as the server replies it.
 struct FrameReply {
-    std::string png;
+    std::string body;                  ///< the pixels in the request's encoding (request.h)
+    std::string content_type;          ///< image/png, or application/octet-stream for rgba
     Camera camera;
     RenderStats stats;
     double encode_seconds = 0;

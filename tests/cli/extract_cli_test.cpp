@@ -1,5 +1,5 @@
 // octiso-info --extract (issue 17, item 3: data back into the ecosystem), end to end: a step
-// written as .vti or .nrrd comes back through octiso-convert (VTK's readers) with the same type,
+// written as .vti, .nrrd, .nii or .nii.gz comes back through octiso-convert (VTK's readers) with the same type,
 // dims, spacing, origin and every voxel byte for byte; .raw is --extract-raw; other extensions,
 // --endian with a headed format, and both extract flags at once exit 2 and write nothing.
 #include <gtest/gtest.h>
@@ -36,7 +36,7 @@ protected:
 };
 
 TEST_F(ExtractCli, VtiAndNrrdComeBackWithTheirPlacementAndEveryVoxel) {
-    for (const char* ext : {".vti", ".nrrd"}) {
+    for (const char* ext : {".vti", ".nrrd", ".nii", ".nii.gz"}) {
         SCOPED_TRACE(ext);
         const std::string out = dir_.file(std::string("x") + ext), back = dir_.file(std::string("back") + ext + ".oct");
         ASSERT_EQ(run_tool("octiso-info", "'" + oct_ + "' --extract '" + out + "'").status, 0);
@@ -56,7 +56,8 @@ TEST_F(ExtractCli, VtiAndNrrdComeBackWithTheirPlacementAndEveryVoxel) {
 
 TEST_F(ExtractCli, UnknownFormatsAndContradictionsAreRefused) {
     ScratchDir out("octiso_extract_bad");
-    for (const std::string& bad : {"--extract '" + out.file("x.nii") + "'", "--extract '" + out.file("x.png") + "'",
+    for (const std::string& bad : {"--extract '" + out.file("x.hdr") + "'", "--extract '" + out.file("x.png") + "'",
+                                   "--extract '" + out.file("x.nii") + "' --endian big",
                                    "--extract '" + out.file("x.vti") + "' --endian big",
                                    "--extract '" + out.file("x.vti") + "' --extract-raw '" + out.file("y.raw") + "'"}) {
         SCOPED_TRACE(bad);

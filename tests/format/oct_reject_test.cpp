@@ -8,6 +8,7 @@
 #include <random>
 
 #include "format/oct_test_util.h"
+#include "octiso/any_octree.h"
 #include "octiso/decode.h"
 #include "octiso/error.h"
 
@@ -366,6 +367,40 @@ TEST(OctReject, BadHeaderFieldsAreErrors) {
     header_edit("file size", [](FileHeader& h) { h.file_bytes += 64; });
     header_edit("entry size", [](FileHeader& h) { h.section_entry_bytes = 64; });
     header_edit("reserved", [](FileHeader& h) { h.reserved[40] = 1; });
+    header_edit("value slope zero", [](FileHeader& h) { h.value_slope = 0.0; });
+    header_edit("value slope NaN", [](FileHeader& h) { h.value_slope = std::nan(""); });
+    header_edit("value intercept inf", [](FileHeader& h) { h.value_inter = -INFINITY; });
+    header_edit("flipped-axes mask", [](FileHeader& h) { h.flipped_axes = 8; });
+}
+
+TEST(OctReject, VersionOneFilesAskToBeConvertedAgain) {
+    // Version 1 never recorded NIfTI value scaling or flipped axes, so its values may be stored
+    // unscaled: the loader says how to get a file it can trust instead of reading it.
+    ScratchDir dir;
+    const std::string path = dir.file("v1.oct");
+    {
+        const std::vector<uint8_t> v(4 * 4 * 4, 7);
+        AnyOctree::build(VolumeView<uint8_t>{reinterpret_cast<const std::byte*>(v.data()), Dims{4, 4, 4}, false}, Placement{}, {})
+            .save(path);
+    }
+    std::string bytes;
+    {
+        std::ifstream in(path, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    FileHeader h;
+    std::memcpy(&h, bytes.data(), sizeof h);
+    h.version = 1;
+    h.header_checksum = format::checksum(&h, format::kHeaderChecksummedBytes);
+    std::memcpy(bytes.data(), &h, sizeof h);
+    write_bytes(path, bytes.data(), bytes.size());
+    try {
+        OctFile::open(path);
+        ADD_FAILURE() << "a version 1 file was opened";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.exit_status(), 2);
+        EXPECT_NE(std::string(e.what()).find("convert the source again with octiso-convert"), std::string::npos) << e.what();
+    }
 }
 
 TEST(OctReject, NonFilesAndEmptyFilesAreErrors) {

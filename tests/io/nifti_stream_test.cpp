@@ -1,8 +1,8 @@
 // The streaming NIfTI reader (src/io/nifti_stream.cpp, nifti_header.cpp; issue 13) through the
 // converter: real templates (/usr/share/mricron/templates) and hand-made files converted out of
-// core must give the same .oct bytes as the whole-file VTK path, placement from the sform/qform
-// included (CONVENTIONS 2b); a 4-D file becomes a series; what is not streamed yet (value
-// scaling, flipped or oblique affines) is refused with a message under --memory.
+// core must give the same .oct bytes as the whole-file path, placement from the sform/qform
+// included (CONVENTIONS 2b); a 4-D file becomes a series. Scaling, flips and oblique affines
+// against nibabel's reading: nifti_placement_test.cpp.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -16,6 +16,7 @@
 #include "octiso/decode.h"
 #include "octiso/error.h"
 #include "octiso/oct_file.h"
+#include "io/nifti_test_file.h"
 #include "test_util/scratch_dir.h"
 #include "test_util/skip.h"
 
@@ -63,41 +64,6 @@ TEST(NiftiStream, RealTemplatesGiveTheBytesOfTheWholeFilePath) {
     EXPECT_EQ(r.placement.spacing, (std::array<double, 3>{1, 1, 1}));
 }
 
-/// A NIfTI-1 single file: header, 4 extension bytes, `data` at 352. `big` writes every header
-/// number big-endian (the caller passes big-endian data then).
-struct Nifti1 {
-    int16_t dim[8] = {3, 1, 1, 1, 1, 1, 1, 1};
-    int16_t datatype = 4, bitpix = 16;
-    float pixdim[8] = {1, 1, 1, 1, 1, 1, 1, 1};
-    float slope = 1, inter = 0;
-    int16_t qform_code = 0, sform_code = 0;
-    float srow[12] = {};
-    bool big = false;
-
-    std::string bytes(const std::string& data) const {
-        std::string h(352, '\0');
-        auto put = [&](size_t at, auto v) {
-            unsigned char b[sizeof v];
-            std::memcpy(b, &v, sizeof v);
-            if (big) std::reverse(b, b + sizeof v);
-            std::memcpy(&h[at], b, sizeof v);
-        };
-        put(0, int32_t(348));
-        for (int i = 0; i < 8; ++i) put(40 + 2 * size_t(i), dim[i]);
-        put(70, datatype);
-        put(72, bitpix);
-        for (int i = 0; i < 8; ++i) put(76 + 4 * size_t(i), pixdim[i]);
-        put(108, 352.0f);
-        put(112, slope);
-        put(116, inter);
-        put(252, qform_code);
-        put(254, sform_code);
-        for (int i = 0; i < 12; ++i) put(280 + 4 * size_t(i), srow[i]);
-        std::memcpy(&h[344], "n+1\0", 4);
-        return h + data;
-    }
-};
-
 std::string i16_data(uint64_t n, int salt, bool big) {
     std::string d(n * 2, '\0');
     for (uint64_t i = 0; i < n; ++i) {
@@ -108,13 +74,6 @@ std::string i16_data(uint64_t n, int salt, bool big) {
         std::memcpy(&d[2 * i], b, 2);
     }
     return d;
-}
-
-void write_gz(const std::string& path, const std::string& bytes) {
-    gzFile f = ::gzopen(path.c_str(), "wb");
-    ASSERT_NE(f, nullptr);
-    ASSERT_EQ(::gzwrite(f, bytes.data(), unsigned(bytes.size())), int(bytes.size()));
-    ::gzclose(f);
 }
 
 TEST(NiftiStream, BigEndianWithSformAndGzipMatchTheWholeFilePath) {
@@ -162,43 +121,6 @@ TEST(NiftiStream, FourDimensionalFileIsASeries) {
     const ConvertReport d = convert(ConvertSource::file(path), dir.file("d.oct"), BuildOptions{});
     EXPECT_TRUE(d.streamed);
     EXPECT_TRUE(slurp(dir.file("t.oct")) == slurp(dir.file("d.oct")));
-}
-
-void expect_refused_streamed(ScratchDir& dir, const std::string& path, const std::string& words) {
-    try {
-        convert(ConvertSource::file(path), dir.file("out.oct"), BuildOptions{}, streamed());
-        ADD_FAILURE() << path << " was streamed";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.exit_status(), 2);
-        EXPECT_EQ(e.subject(), path);
-        EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
-    }
-    EXPECT_FALSE(std::filesystem::exists(dir.file("out.oct")));
-}
-
-TEST(NiftiStream, ScalingAndFlippedOrObliqueAffinesAreRefusedWithAMessage) {
-    ScratchDir dir("nifti_refuse");
-    Nifti1 n;
-    n.dim[1] = 6, n.dim[2] = 5, n.dim[3] = 4;
-    const std::string data = i16_data(6 * 5 * 4, 3, false);
-    auto write = [&](const std::string& name, const Nifti1& h) {
-        const std::string p = dir.file(name);
-        const std::string b = h.bytes(data);
-        std::ofstream(p, std::ios::binary).write(b.data(), std::streamsize(b.size()));
-        return p;
-    };
-    Nifti1 scaled = n;
-    scaled.slope = 2;
-    expect_refused_streamed(dir, write("scaled.nii", scaled), "value scaling is not implemented");
-    Nifti1 flipped = n;
-    flipped.sform_code = 1;
-    const float flip[12] = {-1, 0, 0, 5, 0, 1, 0, 0, 0, 0, 1, 0};
-    std::memcpy(flipped.srow, flip, sizeof flip);
-    expect_refused_streamed(dir, write("flipped.nii", flipped), "sform flips axis x");
-    Nifti1 oblique = flipped;
-    const float rot[12] = {0.8f, 0.6f, 0, 0, -0.6f, 0.8f, 0, 0, 0, 0, 1, 0};
-    std::memcpy(oblique.srow, rot, sizeof rot);
-    expect_refused_streamed(dir, write("oblique.nii", oblique), "oblique sform");
 }
 
 TEST(NiftiStream, WholeFileFormatsOverAnExplicitBudgetAreRefused) {

@@ -4,8 +4,9 @@
 Starts octiso-view on a synthetic volume, opens the page with Selenium, moves the isovalue slider
 with the keyboard and orbits with a mouse drag on the image, waits for the full frame of that
 input, and checks that the frame the page shows is, pixel for pixel, the image octiso-render
-writes for the command the page offers ("copy command"). Pixels are compared after decoding both
-PNGs (a small decoder below), and the page's displayed <img> is read back through a canvas too.
+writes for the command the page offers ("copy command"): the raw RGBA frame the page received on
+loopback, then the same view asked again as PNG (the encoding used from another host; decoded by
+a small decoder below), and each time the page's canvas read back as it is on screen.
 
     tests/view/e2e_view.py TOOLS_DIR
 
@@ -134,44 +135,70 @@ def main():
             .move_by_offset(40, -30).release().perform()
         wait.until(lambda d: settled(d) and d.execute_script("return window.octiso.lastFrame.command") != first)
 
-        shown = driver.execute_async_script("""
-            const done = arguments[arguments.length - 1];
-            const f = window.octiso.lastFrame;
-            const img = document.getElementById('frame');
-            const canvas = document.createElement('canvas');
-            canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
-            const g = canvas.getContext('2d');
-            g.drawImage(img, 0, 0);
-            const px = Array.from(g.getImageData(0, 0, canvas.width, canvas.height).data);
-            const reader = new FileReader();
-            reader.onload = () => done({png: reader.result.split(',')[1], command: f.command, iso: f.iso,
-                                        full: f.full, width: f.width, height: f.height, canvas: px,
-                                        natural: [img.naturalWidth, img.naturalHeight],
-                                        view: [window.innerWidth, window.innerHeight], errors: window.octiso.errors});
-            reader.readAsDataURL(f.blob);""")
-        assert shown["errors"] == 0, "the page showed an error"
-        assert shown["full"], "the settled frame is the full-resolution one"
-        assert [shown["width"], shown["height"]] == shown["view"], (shown["width"], shown["height"], shown["view"])
-        assert shown["natural"] == shown["view"], (shown["natural"], shown["view"])
-        assert shown["iso"] == iso_after, (shown["iso"], iso_after)
-        command = shown["command"]
-        assert f" --iso {iso_after} " in command, command
+        def shown_frame():
+            """The newest frame as received (raw RGBA bytes, or the PNG) and the canvas on screen."""
+            return driver.execute_async_script("""
+                const done = arguments[arguments.length - 1];
+                const f = window.octiso.lastFrame;
+                const canvas = document.getElementById('frame');
+                const px = Array.from(canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data);
+                const result = {command: f.command, iso: f.iso, full: f.full, width: f.width, height: f.height,
+                                encoding: f.encoding, canvas: px, natural: [canvas.width, canvas.height],
+                                view: [window.innerWidth, window.innerHeight], errors: window.octiso.errors};
+                if (f.encoding === 'rgba') { result.rgba = Array.from(f.bytes); done(result); return; }
+                const reader = new FileReader();
+                reader.onload = () => { result.png = reader.result.split(',')[1]; done(result); };
+                reader.readAsDataURL(f.blob);""")
 
-        # The command the page offers, run as given (only the output name replaced).
-        args = shlex.split(command)
-        assert args[0] == "octiso-render" and args[1] == oct_path, args
-        out = os.path.join(work, "reference.png")
-        args = [f"{tools}/octiso-render"] + args[1:-1] + [out]
-        subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        ref_w, ref_h, ref = decode_png(open(out, "rb").read())
-        got_w, got_h, got = decode_png(base64.b64decode(shown["png"]))
-        assert (got_w, got_h) == (ref_w, ref_h) == tuple(shown["view"]), ((got_w, got_h), (ref_w, ref_h))
-        differing = sum(1 for i in range(0, len(ref), 3) if ref[i:i + 3] != got[i:i + 3])
-        assert differing == 0, f"{differing} of {ref_w * ref_h} pixels differ from octiso-render's image"
-        # What is on screen: the <img> drawn into a canvas (RGBA) has the same pixels.
-        canvas = bytes(v for j, v in enumerate(shown["canvas"]) if j % 4 != 3)
-        differing = sum(1 for i in range(0, len(ref), 3) if ref[i:i + 3] != canvas[i:i + 3])
-        assert differing == 0, f"{differing} pixels of the displayed image differ from octiso-render's image"
+        def rgb_of_rgba(values, what):
+            assert all(v == 255 for v in values[3::4]), f"{what}: not opaque"
+            return bytes(v for j, v in enumerate(values) if j % 4 != 3)
+
+        def check(shown, expected_encoding, ref=None):
+            """Asserts the frame is the full one of the current input, shown pixel for pixel as
+            received; returns octiso-render's image for the offered command (run once, then reused)."""
+            assert shown["errors"] == 0, "the page showed an error"
+            assert shown["encoding"] == expected_encoding, (shown["encoding"], expected_encoding)
+            assert shown["full"], "the settled frame is the full-resolution one"
+            assert [shown["width"], shown["height"]] == shown["view"], (shown["width"], shown["height"], shown["view"])
+            assert shown["natural"] == shown["view"], (shown["natural"], shown["view"])
+            assert shown["iso"] == iso_after, (shown["iso"], iso_after)
+            command = shown["command"]
+            assert f" --iso {iso_after} " in command, command
+            if ref is None:
+                # The command the page offers, run as given (only the output name replaced).
+                args = shlex.split(command)
+                assert args[0] == "octiso-render" and args[1] == oct_path, args
+                out = os.path.join(work, "reference.png")
+                args = [f"{tools}/octiso-render"] + args[1:-1] + [out]
+                subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                ref = (command,) + decode_png(open(out, "rb").read())
+            assert command == ref[0], (command, ref[0])
+            ref_w, ref_h, ref_rgb = ref[1:]
+            if shown["encoding"] == "rgba":
+                got_w, got_h, got = shown["width"], shown["height"], rgb_of_rgba(shown["rgba"], "received frame")
+            else:
+                got_w, got_h, got = decode_png(base64.b64decode(shown["png"]))
+            assert (got_w, got_h) == (ref_w, ref_h) == tuple(shown["view"]), ((got_w, got_h), (ref_w, ref_h))
+            assert len(got) == len(ref_rgb), (len(got), len(ref_rgb))
+            differing = sum(1 for i in range(0, len(ref_rgb), 3) if ref_rgb[i:i + 3] != got[i:i + 3])
+            assert differing == 0, f"{differing} of {ref_w * ref_h} pixels differ from octiso-render's image ({shown['encoding']})"
+            # What is on screen: the page's canvas has the same pixels.
+            canvas = rgb_of_rgba(shown["canvas"], "canvas")
+            differing = sum(1 for i in range(0, len(ref_rgb), 3) if ref_rgb[i:i + 3] != canvas[i:i + 3])
+            assert differing == 0, f"{differing} pixels of the displayed image differ from octiso-render's image ({shown['encoding']})"
+            return ref
+
+        # On loopback the page asks for raw RGBA frames; then the same view once more as PNG (the
+        # encoding it uses from another host), which must show the same pixels.
+        ref = check(shown_frame(), "rgba")
+        seq = driver.execute_script("""
+            window.octiso.encoding = 'png';
+            document.getElementById('iso').dispatchEvent(new Event('change'));
+            return window.octiso.lastFrame.seq;""")
+        wait.until(lambda d: settled(d) and d.execute_script("return window.octiso.lastFrame.seq") > seq)
+        check(shown_frame(), "png", ref)
+        command, ref_w, ref_h, ref = ref
         background = ref[0:3]
         hit = sum(1 for i in range(0, len(ref), 3) if ref[i:i + 3] != background)
         assert hit > ref_w * ref_h // 20, f"only {hit} pixels show the surface: a trivial frame proves little"

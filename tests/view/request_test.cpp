@@ -39,6 +39,17 @@ TEST(ViewRequest, ParsesTheRequiredParametersAndDefaultsTheRest) {
     EXPECT_EQ(r.zoom, 1.0);
     EXPECT_EQ(r.step, 0u);
     EXPECT_EQ(r.seq, 0u);
+    EXPECT_EQ(r.encoding, FrameEncoding::png);
+}
+
+TEST(ViewRequest, EncodingIsPngOrRgba) {
+    EXPECT_EQ(parse_frame_request(with(base(), "enc", "png"), 1).encoding, FrameEncoding::png);
+    EXPECT_EQ(parse_frame_request(with(base(), "enc", "rgba"), 1).encoding, FrameEncoding::rgba);
+    for (const std::string bad : {"", "PNG", "rgb", "jpeg", "rgba ", "raw"})
+        EXPECT_EQ(refusal(with(base(), "enc", bad)), "enc") << "'" << bad << "'";
+    QueryParameters twice = with(base(), "enc", "rgba");
+    twice.emplace_back("enc", "png");
+    EXPECT_EQ(refusal(twice), "enc");
 }
 
 TEST(ViewRequest, ParsesOptionalParameters) {

@@ -123,6 +123,32 @@ TEST_F(ViewServerTest, FrameIsTheRenderersImageAndItsCommandReproducesTheCamera)
               std::string::npos) << res->get_header_value("X-Octiso-Stats");
 }
 
+TEST_F(ViewServerTest, RgbaFrameIsTheRenderersPixelsAsTheyAre) {
+    start();
+    auto res = get("/frame?iso=5.5&az=30&el=-20&zoom=1.5&w=48&h=32&seq=4&enc=rgba");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << res->body;
+    EXPECT_EQ(res->get_header_value("Content-Type"), "application/octet-stream");
+    EXPECT_EQ(res->get_header_value("X-Octiso-Size"), "48x32");
+    EXPECT_EQ(res->get_header_value("X-Octiso-Seq"), "4");
+
+    const AnyOctree tree = AnyOctree::open(path_);
+    const Camera camera = orbit_camera(tree.dims(), tree.placement(), 48, 32, 30, -20, 1.5);
+    RenderOptions options;
+    options.isovalues = {5.5};
+    const Frame expected = tree.render(camera, options);   // through Embree: the viewer calls the kernel directly
+    EXPECT_GT(expected.stats.hits, 0u);
+    ASSERT_EQ(res->body.size(), size_t(48) * 32 * 4);
+    size_t differing = 0, translucent = 0;
+    for (size_t i = 0; i < size_t(48) * 32; ++i) {
+        for (int c = 0; c < 3; ++c) differing += uint8_t(res->body[4 * i + c]) != expected.rgb[3 * i + c];
+        translucent += uint8_t(res->body[4 * i + 3]) != 255;
+    }
+    EXPECT_EQ(differing, 0u);
+    EXPECT_EQ(translucent, 0u);
+    EXPECT_NE(res->get_header_value("X-Octiso-Stats").find(";wait="), std::string::npos) << res->get_header_value("X-Octiso-Stats");
+}
+
 TEST_F(ViewServerTest, ServesOnlyItsOwnRoutes) {
     start();
     for (const std::string target : {"/index.html", "/viewer.html", "/../etc/passwd", "/%2e%2e/etc/passwd",
