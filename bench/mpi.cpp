@@ -30,7 +30,7 @@ namespace octiso::bench {
 namespace {
 
 const char* const kMpiUsage =
-    "usage: octiso-bench mpi [--size N] [--series N,STEPS] [--rounds K] [--quick] [--results DIR]\n"
+    "usage: octiso-bench mpi [--size N] [--series N,STEPS] [--rounds K] [--only series] [--quick] [--results DIR]\n"
     "  plume N^3 (default 512) for the frames and the residency, plume-series N,STEPS (default 128,32)\n"
     "  for the series; K interleaved rounds of the series runs (default 3)";
 
@@ -38,7 +38,9 @@ using nlohmann::json;
 
 /// Runs `mpirun -np ranks octiso-render args` and returns its --json (rank 0's stdout).
 json mpirun_render(int ranks, const std::vector<std::string>& args, double& outer_seconds) {
-    std::string cmd = shell_quote(OCTISO_MPIEXEC) + " --oversubscribe -np " + std::to_string(ranks) + " " +
+    // --bind-to none: Open MPI binds each rank to one core by default (np <= 2), which would put
+    // a rank's TBB threads on one core (measured: 1 rank x 2 threads no faster than x 1).
+    std::string cmd = shell_quote(OCTISO_MPIEXEC) + " --bind-to none --oversubscribe -np " + std::to_string(ranks) + " " +
                       shell_quote(tools_dir() + "/octiso-render");
     for (const std::string& a : args) cmd += " " + shell_quote(a);
     cmd += " --json 2>/dev/null";
@@ -101,8 +103,11 @@ int run_mpi(cli::Args& args) {
     }
     const bool quick = args.flag("--quick");
     const auto size_flag = args.value("--size"), series_flag = args.value("--series"), rounds_flag = args.value("--rounds");
+    const auto only = args.value("--only");
     const std::string results = results_dir(args);
     args.finish();
+    if (only && *only != "series") throw Error("--only", "expected series, found '" + *only + "'");
+    const bool all_parts = !only;
     if (std::string(OCTISO_MPIEXEC).empty()) throw Error("mpi", "this octiso-bench was built without MPI", ErrorKind::Other);
     ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);   // CI runs as root
     ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
@@ -114,14 +119,14 @@ int run_mpi(cli::Args& args) {
     const std::string dir = std::filesystem::temp_directory_path().string() + "/octiso-bench-mpi-" + std::to_string(::getpid());
     std::filesystem::create_directories(dir);
     const std::string volume = dir + "/plume.oct", series = dir + "/series.oct";
-    run_tool("octiso-convert", {"--synthetic", "plume:" + std::to_string(n), "-o", volume});
+    if (all_parts) run_tool("octiso-convert", {"--synthetic", "plume:" + std::to_string(n), "-o", volume});
     run_tool("octiso-convert", {"--synthetic", "plume-series:" + series_spec, "-o", series});
     const std::string iso = fmt(default_isovalue("plume"), 1);
 
     // 1. Modes x ranks x threads: frame time (an orbit's frames; steps: wall / frames, as the
     // frames run side by side) and bytes sent per rank per frame.
     std::vector<ModeRow> modes;
-    for (const int size : sizes)
+    for (const int size : all_parts ? sizes : std::vector<int>{})
         for (const std::string mode : {"steps", "image", "data"})
             for (const auto& [ranks, threads] : {std::pair{1, 1}, std::pair{2, 1}, std::pair{1, 2}}) {
                 const std::string s = std::to_string(size);
@@ -162,11 +167,11 @@ int run_mpi(cli::Args& args) {
         uint64_t resident, brick, share;
     };
     std::vector<Residency> residency;
-    const std::shared_ptr<const OctFile> file = std::make_shared<const OctFile>(OctFile::open(volume));
-    const AnyOctree tree = AnyOctree::step(file, 0);
-    const Octree<uint8_t>* typed = tree.as<uint8_t>();
-    if (!typed) throw Error(volume, "expected u8 plume", ErrorKind::Other);
-    for (const int ranks : {2, 4}) {
+    for (const int ranks : all_parts ? std::vector<int>{2, 4} : std::vector<int>{}) {
+        const std::shared_ptr<const OctFile> file = std::make_shared<const OctFile>(OctFile::open(volume));
+        const AnyOctree tree = AnyOctree::step(file, 0);
+        const Octree<uint8_t>* typed = tree.as<uint8_t>();
+        if (!typed) throw Error(volume, "expected u8 plume", ErrorKind::Other);
         const std::string s = std::to_string(sizes.front());
         double outer = 0;
         const json r = mpirun_render(ranks, {volume, "--iso", iso, "--distribute", "data", "-o", dir + "/r.png", "--size", s + "x" + s,
@@ -220,7 +225,7 @@ int run_mpi(cli::Args& args) {
     std::cout << "(the cost levels off at about two frames' transfer and one frame's merge per rank: compositing does not\n"
                  " grow with the rank count, the gather to rank 0 is the serial part)\n";
 
-    const std::string path = write_json(results, quick ? "mpi_quick" : "mpi", [&](cli::JsonWriter& j) {
+    const std::string path = write_json(results, quick ? "mpi_quick" : all_parts ? "mpi" : "mpi_series", [&](cli::JsonWriter& j) {
         j.field("machine", machine_description()).field("plume", n).field("series", series_spec).field("iso", iso);
         j.key("modes").begin_array();
         for (const ModeRow& m : modes)

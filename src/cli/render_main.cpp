@@ -219,17 +219,31 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     }
     // Issue 17: an isovalue outside the values the steps hold draws nothing; refuse it, naming the
     // range (the union of the rendered steps' root min/max, exact).
+    // Reading a step's range validates the step (checksums, structure): a series dealt over ranks
+    // splits that work (step k on rank k mod R) and unites the ranges after the agreement below.
+    const bool split_validation = ranks.size > 1 && distribute == Distribute::steps;
     std::optional<std::array<double, 2>> data_range;
     for (long long k = first; k <= last; ++k)
-        if (const auto r = AnyOctree::step(file, uint32_t(k)).info().value_range)
-            data_range = data_range ? std::array<double, 2>{std::min((*data_range)[0], (*r)[0]), std::max((*data_range)[1], (*r)[1])} : *r;
-    if (data_range) data_range = info.value_scale.real_range(*data_range);
-    if (data_range)
-        for (const double v : real_isovalues)
-            if (v < (*data_range)[0] || v > (*data_range)[1])
-                throw Error(inputs[0], "isovalue " + cli::number(v) + " lies outside the data range " + cli::number((*data_range)[0]) +
-                                           " .. " + cli::number((*data_range)[1]) + (last > first ? " of the rendered steps" : "") +
-                                           " (nothing would be drawn; octiso-info shows the values)");
+        if (!split_validation || (k - first) % ranks.size == ranks.rank)
+            if (const auto r = AnyOctree::step(file, uint32_t(k)).info().value_range)
+                data_range = data_range ? std::array<double, 2>{std::min((*data_range)[0], (*r)[0]), std::max((*data_range)[1], (*r)[1])} : *r;
+    const auto refuse_outside_range = [&]() -> int {
+        if (data_range) data_range = info.value_scale.real_range(*data_range);
+        if (data_range)
+            for (const double v : real_isovalues)
+                if (v < (*data_range)[0] || v > (*data_range)[1]) {
+                    const Error e(inputs[0], "isovalue " + cli::number(v) + " lies outside the data range " + cli::number((*data_range)[0]) +
+                                                 " .. " + cli::number((*data_range)[1]) + (last > first ? " of the rendered steps" : "") +
+                                                 " (nothing would be drawn; octiso-info shows the values)");
+                    if (!split_validation) throw e;
+                    // Every rank holds the same united range, so every rank decides the same: one prints.
+                    if (ranks.rank == 0) std::fprintf(stderr, "octiso-render: %s\n", e.what());
+                    return e.exit_status();
+                }
+        return 0;
+    };
+    if (!split_validation)
+        if (const int refused = refuse_outside_range()) return refused;
     const RenderLimits limits{info.iso_range, inputs[0]};
     validate_options(options, limits);
 
@@ -259,6 +273,10 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     }
     // Every rank got this far (or a lower one reports why not): from here a failure aborts all.
     if (const int failed = ranks.agree_ready(0)) return failed;
+    if (split_validation) {
+        data_range = ranks.unite_range(data_range);
+        if (const int refused = refuse_outside_range()) return refused;
+    }
     // Sort-last: validation read the whole file; from here this rank holds only what its brick reads.
     if (split_frames && distribute == Distribute::data) file->release_resident_pages();
 

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <optional>
 
 #include "octiso/error.h"
@@ -85,6 +86,18 @@ bool Ranks::should_report([[maybe_unused]] int status, [[maybe_unused]] const st
     }
 #endif
     return true;
+}
+
+std::optional<std::array<double, 2>> Ranks::unite_range(const std::optional<std::array<double, 2>>& mine) {
+#if OCTISO_WITH_MPI
+    if (mpi_) {
+        const double inf = std::numeric_limits<double>::infinity();
+        const std::array<double, 2> united = mpi_->world.unite(mine ? (*mine)[0] : inf, mine ? (*mine)[1] : -inf);
+        if (united[0] > united[1]) return std::nullopt;
+        return united;
+    }
+#endif
+    return mine;
 }
 
 std::vector<int> Ranks::tiles_of(int tile_count) const {

@@ -3,7 +3,9 @@
 // this seam in one file leaves render_main.cpp free of #if and the non-MPI tool unchanged.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <functional>
 #include <memory>
 #include <string>
@@ -62,6 +64,8 @@ public:
     /// the others: the rank prints `message` and aborts every rank (never returns).
     bool should_report(int status, const std::string& message);
 
+    /// Collective: the union of every rank's range (none where no rank has one).
+    std::optional<std::array<double, 2>> unite_range(const std::optional<std::array<double, 2>>& mine);
     std::vector<int> tiles_of(int tile_count) const;   ///< sort-first: tile i with i % size == rank
     RankExchange gather_tiles(const TileGrid& grid, bool colour, bool depth, bool normal, Frame& frame);
     RankExchange composite(const CompositeLayout& layout, Frame& frame);

@@ -42,7 +42,7 @@ void StepDealer::serve() {
         MPI_Status status;
         MPI_Iprobe(MPI_ANY_SOURCE, kAskTag, MPI_COMM_WORLD, &waiting, &status);
         if (!waiting) {
-            std::this_thread::sleep_for(std::chrono::microseconds(200));
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
             continue;
         }
         int ask = 0;

@@ -68,6 +68,14 @@ std::string World::gather_equal(const std::string& bytes) const {
     return all;
 }
 
+std::array<double, 2> World::unite(double lo, double hi) const {
+    std::array<double, 2> out{lo, hi};
+    if (active_ && (MPI_Allreduce(&lo, &out[0], 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD) != MPI_SUCCESS ||
+                    MPI_Allreduce(&hi, &out[1], 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD) != MPI_SUCCESS))
+        throw Error("mpi", "uniting the steps' value ranges failed", ErrorKind::Other);
+    return out;
+}
+
 std::string World::broadcast(std::string bytes) const {
     if (active_ && MPI_Bcast(bytes.data(), int(bytes.size()), MPI_BYTE, 0, MPI_COMM_WORLD) != MPI_SUCCESS)
         throw Error("mpi", "broadcasting from rank 0 failed", ErrorKind::Other);

@@ -6,6 +6,7 @@
 // service thread while its main thread renders (step_dealer.h); TBB's workers never call MPI.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -40,6 +41,8 @@ public:
     /// Gathers `bytes` of equal size from every rank to rank 0 (rank order). Returns them on
     /// rank 0, empty elsewhere.
     std::string gather_equal(const std::string& bytes) const;
+    /// {min of lo, max of hi} over the ranks.
+    std::array<double, 2> unite(double lo, double hi) const;
     /// Rank 0's `bytes` (of the same size on every rank) on every rank.
     std::string broadcast(std::string bytes) const;
 

@@ -109,6 +109,14 @@ def main():
         failures.append(f"a bad flag under mpirun should be reported once, got: {lines}")
     if os.path.exists("never.png"):
         failures.append("a refused run wrote its image")
+    # An isovalue outside the steps' range: the ranks split the validation and unite the ranges,
+    # then every rank refuses alike; one line, exit 2, no frame.
+    p = run(mpi(2, ["series.oct", "--iso", "9999", "--steps", "0:2", "-o", "never_%02d.png"] + look), expect=2)
+    lines = [l for l in p.stderr.splitlines() if l.startswith("octiso-render:")]
+    if len(lines) != 1 or "outside the data range" not in lines[0]:
+        failures.append(f"an isovalue outside the range under mpirun should be refused once, got: {lines}")
+    if any(n.startswith("never_") for n in os.listdir(".")):
+        failures.append("a refused series wrote a frame")
 
     os.chdir("/")
     shutil.rmtree(tmp)
