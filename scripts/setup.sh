@@ -11,6 +11,7 @@ packages=(
   python3-numpy python3-matplotlib python3-dev pybind11-dev python3-pytest python3-nibabel clang
   nlohmann-json3-dev libfmt-dev libcli11-dev python3-pil
   libcpp-httplib-dev chromium chromium-driver python3-selenium
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

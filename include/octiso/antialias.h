@@ -28,5 +28,10 @@ std::array<double, 2> subpixel_offset(int i);
 using SampleShader = std::function<void(const Camera& sample_camera, Frame& sample)>;
 RenderStats render_antialiased(const Renderer& renderer, const Camera& camera, int spp, Frame& frame,
                                const SampleShader& shade = {});
+/// The same over any way of rendering one sample (a distributed render, octiso-render under
+/// mpirun: each sample traced by all ranks and assembled before it is averaged).
+using SampleRenderer = std::function<RenderStats(const Camera& sample_camera, Frame& sample)>;
+RenderStats render_antialiased(const SampleRenderer& render_sample, const Camera& camera, int spp, Frame& frame,
+                               const SampleShader& shade = {});
 
 }  // namespace octiso

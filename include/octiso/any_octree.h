@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <vector>
 #include <optional>
 #include <span>
 #include <string>
@@ -106,6 +107,9 @@ public:
     /// `order`. Throws Error unless out.size() == dense_bytes(); `out` needs no alignment.
     void decode(std::span<std::byte> out, std::endian order = std::endian::native) const;
     uint64_t dense_bytes() const;
+    /// The voxels of the plane x = `x` (< dims().x) as doubles (exact for every scalar type),
+    /// element y + ny * z: the ghost face a sort-last neighbour needs (RenderOptions::ghost_plane).
+    std::vector<double> x_plane(uint32_t x) const;
 
     /// The typed view, or null when T is not type(): the way back to the typed API.
     template <typename T> const Octree<T>* as() const;

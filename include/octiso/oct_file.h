@@ -91,6 +91,11 @@ public:
     /// mapping since is not what was validated (issue 18; policy in src/util/mapping_guard.h).
     /// Tools call it before publishing anything computed from the file.
     void check_unchanged() const;
+    /// Unmaps this process's copies of the file's pages (madvise MADV_DONTNEED on the read-only
+    /// mapping; the data stay valid and fault back in on their next read). Sort-last rendering
+    /// calls it after the steps were validated (which reads every byte), so that what the process
+    /// holds while rendering is what its brick touches (issue 15).
+    void release_resident_pages() const;
 
 private:
     OctFile();

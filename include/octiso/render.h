@@ -58,6 +58,15 @@ struct RenderOptions {
     /// Expert: a packet continues while at least this many lanes enter a subtree; 0 keeps the
     /// measured default (OctreeTracer::kDefaultMinPacketLanes). For the benchmark's A/B.
     int packet_min_lanes = 0;
+    /// Sort-last rendering (octiso-render --distribute data, octiso/bricks.h): only the cells of
+    /// this box are tested, and nodes wholly outside it are never visited (nor their file pages
+    /// touched); a ray's hit is its first hit among those cells, bit for bit the hit of the whole
+    /// volume wherever that lies in the box. Unset: every cell.
+    std::optional<CellBox> owned_cells;
+    /// With owned_cells: the voxels of the plane x = owned_cells->hi[0] (element y + ny * z), the
+    /// ghost face its last cells need. They are read from here instead of the neighbour's nodes,
+    /// whose face is spread over all of its pages (Morton order); null: read from the octree.
+    std::shared_ptr<const std::vector<double>> ghost_plane;
     int threads = 0;                    ///< 0: all cores
     int tile_size = 0;                  ///< square tile side in pixels; 0: tile_size_for() picks it
     /// Every ray's interval is cut to the intersection of these half-spaces before traversal

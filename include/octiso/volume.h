@@ -63,6 +63,14 @@ struct Dims {
     bool operator==(const Dims&) const = default;
 };
 
+/// A half-open box of cells in index space: cell (i, j, k), the one whose lower corner is voxel
+/// (i, j, k), is inside when lo <= (i, j, k) < hi on every axis.
+struct CellBox {
+    std::array<uint32_t, 3> lo{}, hi{};
+    bool empty() const { return !(lo[0] < hi[0] && lo[1] < hi[1] && lo[2] < hi[2]); }
+    bool operator==(const CellBox&) const = default;
+};
+
 /// Parses "NX,NY,NZ"; throws Error(flag, ...) on anything but three integers in [1, kMaxExtent].
 Dims parse_dims(std::string_view text, const std::string& flag);
 /// Byte count of dims x scalar size; throws Error(subject, ...) if it overflows 64 bits.

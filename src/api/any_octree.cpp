@@ -29,6 +29,7 @@ struct AnyOctree::Impl {
     virtual void decode(std::byte* out, bool swap_bytes) const = 0;
     virtual PixelTrace trace_pixel(const Camera& camera, const RenderOptions& options, int x, int y) const = 0;
     virtual const void* typed_view() const = 0;   // the Octree<T> for as<T>()
+    virtual std::vector<double> x_plane(uint32_t x) const = 0;
 
     Placement placement;
     std::optional<std::array<double, 2>> iso_range;
@@ -96,6 +97,13 @@ public:
         return octiso::trace_pixel(tree_, placement, camera, options, x, y);
     }
     const void* typed_view() const override { return &tree_; }
+    std::vector<double> x_plane(uint32_t x) const override {
+        const Dims d = tree_.dims();
+        std::vector<double> plane(size_t(d.y) * d.z);
+        for (uint32_t z = 0; z < d.z; ++z)
+            for (uint32_t y = 0; y < d.y; ++y) plane[size_t(z) * d.y + y] = double(tree_.point_locate(Coord{x, y, z}));
+        return plane;
+    }
 
 private:
     std::optional<OctreeData<T>> data_;   // empty for a file step
@@ -224,6 +232,11 @@ Frame AnyOctree::render(const Camera& camera, const RenderOptions& options) cons
     validate_options(options, render_limits());
     validate_camera(camera);
     return make_renderer(options).render(camera);
+}
+
+std::vector<double> AnyOctree::x_plane(uint32_t x) const {
+    if (x >= dims().x) throw Error("x_plane", "plane " + std::to_string(x) + " outside the data", ErrorKind::Other);
+    return impl_->x_plane(x);
 }
 
 uint64_t AnyOctree::dense_bytes() const { return checked_volume_bytes(dims(), type(), impl_->source); }

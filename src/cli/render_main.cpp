@@ -2,11 +2,14 @@
 // time step with --steps A:B (names then hold one printf integer field, e.g. frame_%04d.png).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <optional>
+#include <utility>
 
 #include "cli/common/cli.h"
 #include "cli/common/json.h"
@@ -15,7 +18,11 @@
 #include "cli/common/report.h"
 #include "cli/render_camera.h"
 #include "cli/render_look.h"
+#include "cli/render_ranks.h"
+#include "util/process_memory.h"
 #include "octiso/antialias.h"
+#include "octiso/bricks.h"
+#include "octiso/depth_composite.h"
 #include "octiso/shading.h"
 #include "octiso/any_octree.h"
 #include "octiso/debug_trace.h"
@@ -72,14 +79,15 @@ const char* kUsage =
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
     "  --version, -h/--help\n";
 
-int run(std::vector<std::string>& argv) {
+int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
+    using cli::Distribute, cli::FrameRecord, cli::RankExchange;
     cli::Args args(argv);
     if (args.flag("--help") || args.flag("-h")) {
-        std::cout << kUsage << cli::kLookUsage;
+        if (ranks.rank == 0) std::cout << kUsage << cli::kLookUsage;
         return 0;
     }
     if (argv.empty()) {   // the same in every tool: the help, as a usage error
-        std::cerr << kUsage << cli::kLookUsage;
+        if (ranks.rank == 0) std::cerr << kUsage << cli::kLookUsage;
         return 2;
     }
     const auto iso_text = args.value("--iso");
@@ -94,12 +102,20 @@ int run(std::vector<std::string>& argv) {
     const bool no_embree = args.flag("--no-embree"), json = args.flag("--json");
     const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
+    const auto distribute_text = args.value("--distribute");
     const cli::LookFlags look_flags = cli::LookFlags::take(args);   // issue 17 item 7
     const std::vector<std::string> inputs = args.positional();
     args.finish();
     if (inputs.size() != 1) throw Error("octiso-render", "expected exactly one FILE.oct (octiso-render --help lists every flag)");
     if (!iso_text) throw Error("--iso", "is required (one or more isovalues, e.g. --iso 40,120)");
     if (!out_path && !depth_path && !normal_path && !debug_pixel) throw Error("-o", "is required (or at least --depth or --normal)");
+
+    const Distribute distribute = distribute_text ? cli::parse_distribute(*distribute_text) : Distribute::steps;
+    if (distribute == Distribute::data && look_flags.look.active())
+        throw Error("--distribute", "data traces each slab alone, so shadow, AO and translucent-layer rays cannot cross "
+                                    "into other slabs; use --distribute image or steps with --shadows, --ao or --opacity");
+    if (distribute_text && !ranks.mpi_built())
+        throw Error("--distribute", "this octiso-render was built without MPI (install libopenmpi-dev and rebuild)");
 
     RenderOptions options;
     options.isovalues = cli::parse_list(*iso_text, "--iso");
@@ -166,7 +182,7 @@ int run(std::vector<std::string>& argv) {
         // never a file literally named frame_%02d.png).
         series = true;
         last = (long long)info.step_count - 1;
-    } else if (info.step_count > 1 && !debug_pixel) {
+    } else if (info.step_count > 1 && !debug_pixel && ranks.rank == 0) {
         std::fprintf(stderr, "octiso-render: note: %s has %u steps; rendering step %lld (--steps A:B, or a %%04d field in -o, renders more)\n",
                      inputs[0].c_str(), info.step_count, first);
     }
@@ -203,17 +219,31 @@ int run(std::vector<std::string>& argv) {
     }
     // Issue 17: an isovalue outside the values the steps hold draws nothing; refuse it, naming the
     // range (the union of the rendered steps' root min/max, exact).
+    // Reading a step's range validates the step (checksums, structure): a series dealt over ranks
+    // splits that work (step k on rank k mod R) and unites the ranges after the agreement below.
+    const bool split_validation = ranks.size > 1 && distribute == Distribute::steps;
     std::optional<std::array<double, 2>> data_range;
     for (long long k = first; k <= last; ++k)
-        if (const auto r = AnyOctree::step(file, uint32_t(k)).info().value_range)
-            data_range = data_range ? std::array<double, 2>{std::min((*data_range)[0], (*r)[0]), std::max((*data_range)[1], (*r)[1])} : *r;
-    if (data_range) data_range = info.value_scale.real_range(*data_range);
-    if (data_range)
-        for (const double v : real_isovalues)
-            if (v < (*data_range)[0] || v > (*data_range)[1])
-                throw Error(inputs[0], "isovalue " + cli::number(v) + " lies outside the data range " + cli::number((*data_range)[0]) +
-                                           " .. " + cli::number((*data_range)[1]) + (last > first ? " of the rendered steps" : "") +
-                                           " (nothing would be drawn; octiso-info shows the values)");
+        if (!split_validation || (k - first) % ranks.size == ranks.rank)
+            if (const auto r = AnyOctree::step(file, uint32_t(k)).info().value_range)
+                data_range = data_range ? std::array<double, 2>{std::min((*data_range)[0], (*r)[0]), std::max((*data_range)[1], (*r)[1])} : *r;
+    const auto refuse_outside_range = [&]() -> int {
+        if (data_range) data_range = info.value_scale.real_range(*data_range);
+        if (data_range)
+            for (const double v : real_isovalues)
+                if (v < (*data_range)[0] || v > (*data_range)[1]) {
+                    const Error e(inputs[0], "isovalue " + cli::number(v) + " lies outside the data range " + cli::number((*data_range)[0]) +
+                                                 " .. " + cli::number((*data_range)[1]) + (last > first ? " of the rendered steps" : "") +
+                                                 " (nothing would be drawn; octiso-info shows the values)");
+                    if (!split_validation) throw e;
+                    // Every rank holds the same united range, so every rank decides the same: one prints.
+                    if (ranks.rank == 0) std::fprintf(stderr, "octiso-render: %s\n", e.what());
+                    return e.exit_status();
+                }
+        return 0;
+    };
+    if (!split_validation)
+        if (const int refused = refuse_outside_range()) return refused;
     const RenderLimits limits{info.iso_range, inputs[0]};
     validate_options(options, limits);
 
@@ -223,15 +253,145 @@ int run(std::vector<std::string>& argv) {
         if (comma == std::string::npos) throw Error("--debug-pixel", "expected X,Y, found '" + *debug_pixel + "'");
         const int x = int(cli::parse_int(debug_pixel->substr(0, comma), "--debug-pixel", INT32_MIN, INT32_MAX));
         const int y = int(cli::parse_int(debug_pixel->substr(comma + 1), "--debug-pixel", INT32_MIN, INT32_MAX));
-        std::cout << AnyOctree::step(file, uint32_t(first)).trace_pixel(cameras[0], trace_options, x, y).text();
+        if (ranks.rank == 0) std::cout << AnyOctree::step(file, uint32_t(first)).trace_pixel(cameras[0], trace_options, x, y).text();
         return 0;
     }
+
+    // ---- Distribution over MPI ranks (issue 15; one rank, the default, is the serial tool) ----
+    const int rank = ranks.rank, rank_count = ranks.size;
+    const bool root = rank == 0;
+    const bool split_frames = distribute != Distribute::steps && rank_count > 1;
+    RenderOptions rank_options = trace_options;
+    CompositeLayout layout;
+    const std::vector<CellBox> bricks = slab_bricks(info.dims, rank_count);
+    if (distribute == Distribute::data) {
+        // Each rank traces its slab of cells (octiso/bricks.h) and the frames are composited by
+        // depth, which needs the depth of every sample whatever is written.
+        rank_options.want_depth = true;
+        rank_options.owned_cells = bricks[size_t(rank)];
+        layout = CompositeLayout{rank_options.want_colour || deferred, normal_path.has_value()};
+    }
+    // Every rank got this far (or a lower one reports why not): from here a failure aborts all.
+    if (const int failed = ranks.agree_ready(0)) return failed;
+    if (split_validation) {
+        data_range = ranks.unite_range(data_range);
+        if (const int refused = refuse_outside_range()) return refused;
+    }
+    // Sort-last: validation read the whole file; from here this rank holds only what its brick reads.
+    if (split_frames && distribute == Distribute::data) file->release_resident_pages();
 
     cli::JsonWriter j(std::cout);
     const auto camera_json = [&](const Camera& c) {
         j.begin_object().key("eye").array(c.eye).key("look").array(c.look).key("up").array(c.up);
         j.field("fov", c.fov_deg).field("width", c.width).field("height", c.height).end_object();
     };
+    cli::ProgressLine progress = cli::ProgressLine::on_stderr(root && rank_count == 1 && jobs.size() > 1, 0.0);
+    std::optional<Renderer> renderer;
+    std::optional<AnyOctree> step_tree;
+    std::optional<LookShader> look_shader;
+    long long renderer_step = -1;
+    uint64_t ghost_bytes = 0;   // sent with the latest step's ghost exchange
+    std::vector<FrameRecord> records;   // this rank's frames
+    const auto wall_start = std::chrono::steady_clock::now();
+    const auto render_job = [&](size_t n) {
+        const Job& job = jobs[n];
+        // One Renderer per step, kept across the frames of an orbit; the Embree device behind it
+        // is shared by the whole process.
+        if (job.step != renderer_step) {
+            renderer.reset();
+            step_tree.emplace(AnyOctree::step(file, uint32_t(job.step)));
+            if (split_frames && distribute == Distribute::data)   // the voxels beyond the slab, from their owner
+                rank_options.ghost_plane = ranks.ghost_plane(bricks, [&](uint32_t x) { return step_tree->x_plane(x); }, ghost_bytes);
+            renderer.emplace(step_tree->make_renderer(rank_options));
+            if (deferred && look.active()) look_shader.emplace(*step_tree, rank_options, look, shading.model);
+            renderer_step = job.step;
+        }
+        FrameRecord record;
+        record.index = job.index, record.step = job.step, record.rank = rank;
+        record.bytes_sent = std::exchange(ghost_bytes, 0);
+        // One sample: traced by this rank (its tiles or its brick when frames are split), shaded
+        // here (deferred shading reads only the pixel's own hit), then assembled on rank 0.
+        const auto render_sample = [&](const Camera& c, Frame& f) {
+            RenderStats stats;
+            if (split_frames && distribute == Distribute::image) {
+                renderer->prepare_frame(c, f);
+                // Pixels of other ranks' tiles are misses here, so shading them costs nothing.
+                std::fill(f.depth.begin(), f.depth.end(), std::numeric_limits<float>::infinity());
+                std::fill(f.normal.begin(), f.normal.end(), 0.0f);
+                const TileGrid grid = renderer->tile_grid(c.width, c.height);
+                stats = renderer->render_tiles(c, ranks.tiles_of(grid.count()), f);
+            } else {
+                stats = renderer->render(c, f);
+            }
+            if (deferred && look_shader) record.look.add(look_shader->shade(c, shading, f));
+            else if (deferred) shade_frame(*step_tree, options.isovalues, c, shading, f);
+            if (split_frames) {
+                const RankExchange cost = distribute == Distribute::image
+                                              ? ranks.gather_tiles(renderer->tile_grid(c.width, c.height), out_path.has_value(),
+                                                                   depth_path.has_value(), normal_path.has_value(), f)
+                                              : ranks.composite(layout, f);
+                record.exchange_seconds += cost.seconds;
+                record.bytes_sent += cost.bytes_sent;
+            } else if (distribute == Distribute::data) {
+                ranks.composite(layout, f);   // one rank: the brick is the volume; unpack is exact
+            }
+            record.rays += stats.rays;
+            record.seconds += stats.seconds;
+            record.threads = stats.threads;
+            return stats;
+        };
+        Frame frame;
+        const auto t0 = std::chrono::steady_clock::now();
+        render_antialiased(SampleRenderer(render_sample), *job.camera, spp, frame);
+        // The whole frame: every sample traced and shaded (record.seconds: the tile loops only).
+        record.frame_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        record.hits = frame.stats.hits;
+        file->check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
+        if (root || !split_frames) {
+            if (out_path) write_colour_image(name_for(out_path, "-o", job.index), frame);
+            if (depth_path) write_depth_image(name_for(depth_path, "--depth", job.index), frame);
+            if (normal_path) write_normal_image(name_for(normal_path, "--normal", job.index), frame);
+            record.wrote = true;
+        }
+        // The effective camera, as flags that reproduce it (issue 17: a view can be pasted back);
+        // after the first image is written, so that a failure stays one line on stderr.
+        if (root && records.empty())
+            std::fprintf(stderr, "camera: %s%s\n", cli::camera_flags_text(cameras[0]).c_str(),
+                         orbit ? (" (first of " + std::to_string(cameras.size()) + " orbit frames)").c_str() : "");
+        if ((root || !split_frames) && (!series || !::isatty(2)))
+            std::fprintf(stderr, "%s%s%s: %dx%d in %.3f s (%.2f Mrays/s, %llu hits, %d threads%s)%s\n",
+                         rank_count > 1 && !split_frames ? ("rank " + std::to_string(rank) + ": ").c_str() : "",
+                         series ? ((orbit ? "frame " : "step ") + std::to_string(job.index) + " ").c_str() : "",
+                         out_path ? name_for(out_path, "-o", job.index).c_str() : "frame", frame.width, frame.height,
+                         record.seconds, record.seconds > 0 ? double(record.rays) / record.seconds * 1e-6 : 0.0,
+                         (unsigned long long)record.hits, record.threads,
+                         spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
+                         orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
+        if (look_shader && (root || !split_frames) && (!series || !::isatty(2))) cli::print_look_stats(record.look);
+        records.push_back(record);
+        progress.update(double(records.size()), double(jobs.size()),
+                        std::to_string(records.size()) + "/" + std::to_string(jobs.size()) + " frames");
+    };
+    if (!split_frames && rank_count > 1) {
+        // Series across ranks: rank 0 deals the jobs one at a time to whichever rank is free.
+        ranks.deal(jobs.size(), render_job);
+    } else {
+        for (size_t n = 0; n < jobs.size(); ++n) render_job(n);
+    }
+    progress.finish();
+    const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    // Rank 0 learns every rank's frames: all of them (steps), or each rank's share of each frame.
+    // Sort-last: how much of the file this rank mapped (issue 15: its brick's pages and little
+    // else; /proc/self/smaps, the kernel's fault-around included).
+    const uint64_t resident = rank_count > 1 ? mapped_resident_bytes(inputs[0]) : 0;
+    const std::vector<FrameRecord> all = ranks.gather_records(records, wall_seconds, resident);
+    if (!root) return 0;
+    std::vector<FrameRecord> frames;   // one per image, in index order, rank 0's share when split
+    for (const FrameRecord& r : all)
+        if (r.wrote) frames.push_back(r);
+    std::sort(frames.begin(), frames.end(), [](const FrameRecord& a, const FrameRecord& b) { return a.index < b.index; });
+    double total_seconds = 0;
+    for (const FrameRecord& r : all) total_seconds += r.seconds;
     if (json) {
         j.begin_object().field("file", inputs[0]).field("type", std::string(scalar_type_name(info.type)));
         j.key("isovalues").array(real_isovalues);
@@ -241,78 +401,83 @@ int run(std::vector<std::string>& argv) {
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
         cli::write_look_json(j, look, options.clip_planes);   // issue 17 item 7
+        j.field("ranks", rank_count).field("distribute", std::string(distribute_name(distribute)));
         j.key("camera");
         camera_json(cameras[0]);
         j.key("frames").begin_array();
-    }
-    cli::ProgressLine progress = cli::ProgressLine::on_stderr(jobs.size() > 1, 0.0);
-    double total_seconds = 0;
-    std::optional<Renderer> renderer;
-    std::optional<AnyOctree> step_tree;
-    std::optional<LookShader> look_shader;
-    long long renderer_step = -1;
-    for (size_t n = 0; n < jobs.size(); ++n) {
-        const Job& job = jobs[n];
-        // One Renderer per step, kept across the frames of an orbit; the Embree device behind it
-        // is shared by the whole process.
-        if (job.step != renderer_step) {
-            renderer.reset();
-            step_tree.emplace(AnyOctree::step(file, uint32_t(job.step)));
-            renderer.emplace(step_tree->make_renderer(trace_options));
-            if (deferred && look.active()) look_shader.emplace(*step_tree, trace_options, look, shading.model);
-            renderer_step = job.step;
-        }
-        Frame frame;
-        LookStats look_stats;
-        const auto t0 = std::chrono::steady_clock::now();
-        render_antialiased(*renderer, *job.camera, spp, frame, deferred ? SampleShader([&](const Camera& c, Frame& f) {
-            if (look_shader) look_stats.add(look_shader->shade(c, shading, f));
-            else shade_frame(*step_tree, options.isovalues, c, shading, f);
-        }) : SampleShader());
-        // The whole frame: every sample traced and shaded (frame.stats.seconds: the tile loops only).
-        const double frame_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        file->check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
-        if (out_path) write_colour_image(name_for(out_path, "-o", job.index), frame);
-        if (depth_path) write_depth_image(name_for(depth_path, "--depth", job.index), frame);
-        if (normal_path) write_normal_image(name_for(normal_path, "--normal", job.index), frame);
-        total_seconds += frame.stats.seconds;
-        // The effective camera, as flags that reproduce it (issue 17: a view can be pasted back);
-        // after the first image is written, so that a failure stays one line on stderr.
-        if (n == 0)
-            std::fprintf(stderr, "camera: %s%s\n", cli::camera_flags_text(cameras[0]).c_str(),
-                         orbit ? (" (first of " + std::to_string(cameras.size()) + " orbit frames)").c_str() : "");
-        if (json) {
-            j.begin_object().field("step", job.step);
-            if (orbit) j.field("frame", job.index);
-            j.field("seconds", frame.stats.seconds).field("frame_seconds", frame_seconds);
-            j.field("mrays_per_second", frame.stats.mrays_per_second()).field("rays", frame.stats.rays);
-            j.field("hits", frame.stats.hits).field("threads", frame.stats.threads);
-            if (out_path) j.field("image", name_for(out_path, "-o", job.index));
-            if (look_shader) cli::write_look_stats_json(j, look_stats);
+        for (const FrameRecord& r : frames) {
+            j.begin_object().field("step", r.step);
+            if (orbit) j.field("frame", r.index);
+            j.field("seconds", r.seconds).field("frame_seconds", r.frame_seconds);
+            j.field("mrays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0.0).field("rays", r.rays);
+            j.field("hits", r.hits).field("threads", r.threads);
+            if (rank_count > 1) j.field("rank", r.rank);
+            if (out_path) j.field("image", name_for(out_path, "-o", r.index));
+            if (look.active()) cli::write_look_stats_json(j, r.look);
             j.key("camera");
-            camera_json(*job.camera);
+            camera_json(*jobs[size_t(r.index - jobs.front().index)].camera);
+            if (split_frames) {   // every rank's share of this frame
+                j.key("ranks").begin_array();
+                for (const FrameRecord& q : all)
+                    if (q.index == r.index)
+                        j.begin_object().field("rank", q.rank).field("seconds", q.seconds).field("rays", q.rays)
+                            .field("exchange_seconds", q.exchange_seconds).field("bytes_sent", q.bytes_sent).end_object();
+                j.end_array();
+            }
             j.end_object();
         }
-        if (!series || !::isatty(2))
-            std::fprintf(stderr, "%s%s: %dx%d in %.3f s (%.2f Mrays/s, %llu hits, %d threads%s)%s\n",
-                         series ? ((orbit ? "frame " : "step ") + std::to_string(job.index) + " ").c_str() : "",
-                         out_path ? name_for(out_path, "-o", job.index).c_str() : "frame", frame.width, frame.height,
-                         frame.stats.seconds, frame.stats.mrays_per_second(), (unsigned long long)frame.stats.hits,
-                         frame.stats.threads, spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
-                         orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
-        if (look_shader && (!series || !::isatty(2))) cli::print_look_stats(look_stats);
-        progress.update(double(n + 1), double(jobs.size()), std::to_string(n + 1) + "/" + std::to_string(jobs.size()) + " frames");
-    }
-    progress.finish();
-    if (json) {
-        j.end_array().field("total_seconds", total_seconds).end_object();
+        j.end_array().field("total_seconds", total_seconds).field("wall_seconds", wall_seconds);
+        if (rank_count > 1) {   // per rank: its steps (or frame shares) and seconds
+            j.key("per_rank").begin_array();
+            for (int q = 0; q < rank_count; ++q) {
+                std::vector<long long> steps_done;
+                double seconds = 0, rank_wall = 0;
+                uint64_t rank_resident = 0;
+                for (const FrameRecord& r : all)
+                    if (r.rank == q)
+                        steps_done.push_back(r.step), seconds += r.seconds, rank_wall = r.rank_wall_seconds,
+                            rank_resident = r.file_resident_bytes;
+                j.begin_object().field("rank", q).field("frames", (long long)steps_done.size());
+                j.key("steps").array(steps_done);
+                j.field("seconds", seconds).field("wall_seconds", rank_wall).field("file_resident_bytes", rank_resident);
+                if (distribute == Distribute::data) {
+                    const CellBox& b = bricks[size_t(q)];
+                    j.key("brick").begin_object().key("lo").array(b.lo).key("hi").array(b.hi).end_object();
+                }
+                j.end_object();
+            }
+            j.end_array();
+        }
+        j.end_object();
         std::cout << "\n";
     }
-    if (series) std::fprintf(stderr, "%zu frames in %.3f s render time\n", jobs.size(), total_seconds);
+    if (series) std::fprintf(stderr, "%zu frames in %.3f s render time%s\n", frames.size(), total_seconds,
+                             rank_count > 1 ? (", " + cli::number(wall_seconds) + " s wall on " + std::to_string(rank_count) + " ranks").c_str() : "");
     return 0;
 }
 
 }  // namespace
 }  // namespace octiso
 
-int main(int argc, char** argv) { return octiso::cli::run_main("octiso-render", argc, argv, octiso::run); }
+int main(int argc, char** argv) {
+    std::optional<octiso::cli::Ranks> ranks;
+    try {
+        ranks.emplace(octiso::cli::Ranks::for_process(argc, argv));   // MPI_Init under mpirun
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "octiso-render: %s\n", e.what());
+        return 1;
+    }
+    // Under mpirun every rank prepares the same work; a failure is reported once, by the lowest
+    // rank that met it, and every rank exits with it (cli/render_ranks.h).
+    return octiso::cli::run_main("octiso-render", argc, argv, [&](std::vector<std::string>& args) {
+        try {
+            return octiso::run(args, *ranks);
+        } catch (const octiso::Error& e) {
+            if (ranks->should_report(e.exit_status(), e.what())) throw;
+            return e.exit_status();
+        } catch (const std::exception& e) {
+            if (ranks->should_report(1, e.what())) throw;
+            return 1;
+        }
+    });
+}

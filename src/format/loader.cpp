@@ -308,6 +308,11 @@ template <typename T> Octree<T> OctFile::step(uint32_t k) const {
 
 StepSizes OctFile::step_sizes(uint32_t k) const { return impl_->ensure_valid(k); }
 
+void OctFile::release_resident_pages() const {
+    // Read-only and never written: dropping the pages loses nothing; a failure only costs memory.
+    ::madvise(const_cast<std::byte*>(impl_->base), size_t(impl_->bytes), MADV_DONTNEED);
+}
+
 void OctFile::check_unchanged() const {
     struct stat st {};
     const Impl& m = *impl_;

@@ -39,9 +39,15 @@ std::array<double, 2> subpixel_offset(int i) {
 }
 
 RenderStats render_antialiased(const Renderer& renderer, const Camera& camera, int spp, Frame& frame, const SampleShader& shade) {
+    return render_antialiased(SampleRenderer([&](const Camera& c, Frame& f) { return renderer.render(c, f); }), camera, spp,
+                              frame, shade);
+}
+
+RenderStats render_antialiased(const SampleRenderer& render_sample, const Camera& camera, int spp, Frame& frame,
+                               const SampleShader& shade) {
     if (spp < 1 || spp > kMaxSamplesPerPixel)
         throw Error("--spp", "expected 1 .. " + std::to_string(kMaxSamplesPerPixel) + " samples per pixel, found " + std::to_string(spp));
-    RenderStats stats = renderer.render(camera, frame);
+    RenderStats stats = render_sample(camera, frame);
     if (shade) shade(camera, frame);
     if (spp == 1 || frame.rgb.empty()) return stats;
     static const LinearFromSrgb8 to_linear;
@@ -51,7 +57,7 @@ RenderStats render_antialiased(const Renderer& renderer, const Camera& camera, i
     for (int s = 1; s < spp; ++s) {
         Camera shifted = camera;
         shifted.pixel_offset = subpixel_offset(s);
-        const RenderStats more = renderer.render(shifted, sample);
+        const RenderStats more = render_sample(shifted, sample);
         stats.seconds += more.seconds;
         stats.rays += more.rays;
         if (shade) shade(shifted, sample);

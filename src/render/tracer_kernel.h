@@ -23,6 +23,7 @@ struct TracerKernel {
     EmbreeVolumeScene::TraceFn trace = nullptr;               ///< one ray
     EmbreeVolumeScene::TracePacketFn trace_packet = nullptr;  ///< up to 8 rays
     Isa isa = Isa::baseline;
+    std::shared_ptr<const std::vector<double>> ghost_plane;   ///< RenderOptions::ghost_plane, if any
 };
 
 // resolve_isa() and cpu_has_avx2() are public (octiso/render.h); defined in kernel_baseline.cpp.

@@ -50,7 +50,9 @@ struct NoRecorder {
     static constexpr bool kOn = false;
 };
 
-template <typename T, class Finder, class Corners = OctreeCornerSource, class Recorder = NoRecorder>
+/// kOwned: the sort-last tracer (set_owned_cells); a parameter, not a flag, because its tests on
+/// every cell and corner cost 4 % of a frame when compiled in and unused (A/B, BENCHMARKS.md MPI).
+template <typename T, class Finder, class Corners = OctreeCornerSource, class Recorder = NoRecorder, bool kOwned = false>
 class OctreeTracer {
     static constexpr bool kOwnCorners = std::is_same_v<Corners, OctreeCornerSource>;
 
@@ -83,6 +85,19 @@ public:
     /// against a frame in flight.
     void set_min_packet_lanes(int lanes) { min_packet_lanes_ = std::max(1, lanes); }
 
+    /// Sort-last (RenderOptions::owned_cells): only the cells of `box` are tested and subtrees
+    /// wholly outside it are skipped where min/max culling would skip them. The child intervals
+    /// are computed exactly as without the box, so a hit inside it is the whole volume's hit bit
+    /// for bit; cells are half-open along the ray, so a surface on a box face is claimed by the
+    /// box whose cell the ray enters there, once. Not thread-safe against a frame in flight.
+    /// `ghost_plane` (may be null): the voxels of x = box.hi[0], element y + ny * z, read in
+    /// place of the octree for the +x corners of the box's last cells (RenderOptions::ghost_plane).
+    void set_owned_cells(const CellBox& box, const double* ghost_plane = nullptr) {
+        static_assert(kOwned, "set_owned_cells needs OctreeTracer<..., kOwned = true>");
+        owned_ = box;
+        ghost_ = ghost_plane;
+    }
+
     /// First hits of rays[0 .. count), count <= kMaxPacket; lanes with valid[k] == 0 (valid may be
     /// null: all valid) are misses. Every hit equals trace(rays[k]) bit for bit: each lane sees the
     /// same child intervals, culls and cell walks as alone (see packet_node). Thread-safe.
@@ -114,6 +129,31 @@ public:
     }
 
 private:
+    /// Whether the cube [o, o + side)^3 of cells meets the owned box.
+    bool overlaps_owned(const Coord& o, uint32_t side) const {
+        const uint32_t lo[3] = {o.x, o.y, o.z};
+        for (int a = 0; a < 3; ++a)
+            if (uint64_t(lo[a]) + side <= owned_.lo[a] || lo[a] >= owned_.hi[a]) return false;
+        return true;
+    }
+    /// Whether the cube [o, o + side)^3 of cells lies wholly in the owned box.
+    bool inside_owned(const Coord& o, uint32_t side) const {
+        const uint32_t lo[3] = {o.x, o.y, o.z};
+        for (int a = 0; a < 3; ++a)
+            if (lo[a] < owned_.lo[a] || uint64_t(lo[a]) + side > owned_.hi[a]) return false;
+        return true;
+    }
+    /// Corner k (x offset 1) of such a cell, from the ghost plane.
+    double ghost_value(const Coord& v, int k) const {
+        const uint64_t y = v.y + ((k >> 1) & 1), z = v.z + ((k >> 2) & 1);
+        return ghost_[z * tree_.dims().y + y];
+    }
+    bool owns_cell(const int64_t cell[3]) const {
+        for (int a = 0; a < 3; ++a)
+            if (cell[a] < int64_t(owned_.lo[a]) || cell[a] >= int64_t(owned_.hi[a])) return false;
+        return true;
+    }
+
     static Coord child_origin_of(const Coord& o, int c, uint32_t half) {
         return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
     }
@@ -151,6 +191,7 @@ private:
                                    t_next);
             if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) return false;
             const Coord co = child_origin_of(o, c, half);
+            if (restricted_ && !overlaps_owned(co, half)) return false;
             if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
             else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;
@@ -245,6 +286,7 @@ private:
             const unsigned entered = lanes_in[c] & active;
             if (!entered || !n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
             const Coord co = child_origin_of(o, int(c), half);
+            if (restricted_ && !overlaps_owned(co, half)) continue;
             unsigned hit = 0;
             if (n.is_scalar_leaf(int(c))) {
                 for (unsigned m = entered; m; m &= m - 1) {
@@ -281,13 +323,20 @@ private:
         const Cap<T>& cap = tree_.cap(cap_index);
         LeafRef<T>* block = blocks.block;
         unsigned& located = blocks.located;
-        return walk_cells(w, co, 2, t0, t1, [&](Coord v, double corner[8]) {
+        // Sort-last (set_owned_cells): decided once per cap.
+        const bool cap_on_ghost = restricted_ && ghost_ && co.x + 2 == owned_.hi[0];
+        return walk_cells(w, co, 2, t0, t1, restricted_ && !inside_owned(co, 2), [&](Coord v, double corner[8]) {
             if constexpr (!kOwnCorners) {
                 corners_.gather(v, corner);
                 return;
             }
             const int oct = int(((v.x - co.x) << 2) | ((v.y - co.y) << 1) | (v.z - co.z));
+            const bool on_ghost = cap_on_ghost && v.x + 1 == owned_.hi[0];
             for (int k = 0; k < 8; ++k) {
+                if (on_ghost && (k & 1)) [[unlikely]] {
+                    corner[k] = ghost_value(v, k);
+                    continue;
+                }
                 const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
                 const int r = oct & dir;                                         // which block holds the corner
                 if (r == 0) {
@@ -308,23 +357,26 @@ private:
     bool scalar_leaf(RayState& w, const uint32_t* trace, int holder_depth, const Coord& co, uint32_t side, T value,
                      double t0, double t1) const {
         const double v = double(value);
+        const bool leaf_on_ghost = restricted_ && ghost_ && co.x + side == owned_.hi[0];
+        const bool partial = restricted_ && !inside_owned(co, side);   // cells outside the box skipped
         auto gather = [&](Coord p, double corner[8]) {
             if constexpr (!kOwnCorners) {
                 corners_.gather(p, corner);
                 return;
             }
             const uint32_t ex = co.x + side, ey = co.y + side, ez = co.z + side;
+            const bool on_ghost = leaf_on_ghost && p.x + 1 == owned_.hi[0];
             for (int k = 0; k < 8; ++k) {
                 const Coord dest{p.x + (k & 1), p.y + ((k >> 1) & 1), p.z + ((k >> 2) & 1)};
-                corner[k] = (dest.x < ex && dest.y < ey && dest.z < ez)
-                                ? v
-                                : double(tree_.neighbour_find(p, dest, holder_depth, trace));
+                corner[k] = (dest.x < ex && dest.y < ey && dest.z < ez) ? v
+                            : (on_ghost && (k & 1))                     ? ghost_value(p, k)
+                                                                        : double(tree_.neighbour_find(p, dest, holder_depth, trace));
             }
         };
         bool iso_equals_value = false;
         for (int i = 0; i < scene_.iso_count; ++i) iso_equals_value |= scene_.isovalues[i] == v;
         if constexpr (Recorder::kOn) recorder_.scalar_leaf(holder_depth, co, side, v, t0, t1, iso_equals_value);
-        if (iso_equals_value) return walk_cells(w, co, side, t0, t1, gather);
+        if (iso_equals_value) return walk_cells(w, co, side, t0, t1, partial, gather);
 
         // Skip the inner cells [co, co + side - 1)^3: constant, never crossed by another iso.
         double ti0 = t0, ti1 = t1;
@@ -340,9 +392,9 @@ private:
             ti0 = std::max(ti0, ta);
             ti1 = std::min(ti1, tb);
         }
-        if (!(ti0 < ti1)) return walk_cells(w, co, side, t0, t1, gather);
-        if (ti0 > t0 && walk_cells(w, co, side, t0, ti0, gather)) return true;
-        return ti1 < t1 && walk_cells(w, co, side, ti1, t1, gather);
+        if (!(ti0 < ti1)) return walk_cells(w, co, side, t0, t1, partial, gather);
+        if (ti0 > t0 && walk_cells(w, co, side, t0, ti0, partial, gather)) return true;
+        return ti1 < t1 && walk_cells(w, co, side, ti1, t1, partial, gather);
     }
 
     /// The cells of the box [lo, lo + side)^3 that the ray crosses on [t0, t1), in order, by the
@@ -350,7 +402,8 @@ private:
     /// the data exit); `gather` fills its 8 corners. Cells of the box beyond the data (padding)
     /// are stepped over. Returns true at the first hit.
     template <class Gather>
-    bool walk_cells(RayState& w, const Coord& lo, uint32_t side, double t0, double t1, Gather&& gather) const {
+    /// `partial`: the box reaches past the owned cells (set_owned_cells); those are skipped.
+    bool walk_cells(RayState& w, const Coord& lo, uint32_t side, double t0, double t1, bool partial, Gather&& gather) const {
         const Dims dims = tree_.dims();
         const int64_t last_cell[3] = {int64_t(dims.x) - 2, int64_t(dims.y) - 2, int64_t(dims.z) - 2};
         const DdaBox box{{lo.x, lo.y, lo.z},
@@ -362,6 +415,7 @@ private:
                               if (cell[0] > last_cell[0] || cell[1] > last_cell[1] || cell[2] > last_cell[2])
                                   return false;
                               OCTISO_DCHECK(cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0, "cell below the data box");
+                              if (partial && !owns_cell(cell)) [[unlikely]] return false;
                               const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
                               double corner[8];
                               gather(v, corner);
@@ -385,6 +439,9 @@ private:
     const CellWalkScene scene_;
     const Finder finder_;
     int min_packet_lanes_ = kDefaultMinPacketLanes;
+    static constexpr bool restricted_ = kOwned;
+    CellBox owned_;
+    const double* ghost_ = nullptr;   ///< the plane x = owned_.hi[0], or null
     [[no_unique_address]] const Corners corners_;
     [[no_unique_address]] const Recorder recorder_;
 };
