@@ -175,7 +175,7 @@ std::vector<FrameRecord> Ranks::gather_records(std::vector<FrameRecord> mine, do
         most_bytes = mpi_->world.broadcast(most_bytes);
         std::memcpy(&most, most_bytes.data(), sizeof most);
         std::string rows(size_t(most) * sizeof(FrameRecord), '\0');
-        std::memcpy(rows.data(), mine.data(), mine.size() * sizeof(FrameRecord));
+        if (!mine.empty()) std::memcpy(rows.data(), mine.data(), mine.size() * sizeof(FrameRecord));   // a rank with no step has no data()
         const std::string all = mpi_->world.gather_equal(rows);
         if (rank != 0) return mine;
         std::vector<FrameRecord> out;
