@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "cli/cli_test_util.h"
+#include "cli/marschner_render_fixture.h"
 #include "octiso/image.h"
 #include "test_util/skip.h"
 
@@ -15,20 +16,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class ShadingCli : public ::testing::Test {
+class ShadingCli : public MarschnerRenderCli {
 protected:
-    void SetUp() override {
-        for (const char* tool : {"octiso-convert", "octiso-render"})
-            if (!fs::exists(std::string(OCTISO_TOOLS_DIR) + "/" + tool)) { OCTISO_SKIP(tool << " not built"); }
-        ASSERT_EQ(run_tool("octiso-convert", "--synthetic marschner-lobb:25 --type f32 -o '" + oct_ + "'").status, 0);
-    }
-    ToolRun render(const std::string& flags, const std::string& name) {
-        return run_tool("octiso-render", "'" + oct_ + "' --iso 0.3,0.6 --size 40x32 " + flags + " -o '" + dir_.file(name) +
-                                             ".png' --depth '" + dir_.file(name) + ".exr' --json");
-    }
-    FloatImage image(const std::string& name) { return read_image(dir_.file(name)); }
-    ScratchDir dir_{"octiso_shading_cli"};
-    std::string oct_ = dir_.file("ml.oct");
+    ShadingCli() : MarschnerRenderCli("octiso_shading_cli") {}
 };
 
 TEST_F(ShadingCli, TheKitIsTheDefaultAndChangesColourNotDepth) {
