@@ -332,8 +332,6 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                                               : ranks.composite(layout, f);
                 record.exchange_seconds += cost.seconds;
                 record.bytes_sent += cost.bytes_sent;
-            } else if (distribute == Distribute::data) {
-                ranks.composite(layout, f);   // one rank: the brick is the volume; unpack is exact
             }
             record.rays += stats.rays;
             record.seconds += stats.seconds;
