@@ -1,6 +1,7 @@
 // Ranks (render_ranks.h): src/mpi/ behind the seam in the MPI build, one rank otherwise.
 #include "cli/render_ranks.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -101,9 +102,13 @@ std::optional<std::array<double, 2>> Ranks::unite_range(const std::optional<std:
 }
 
 std::vector<int> Ranks::tiles_of(int tile_count) const {
-    std::vector<int> tiles;
-    for (int i = rank; i < tile_count; i += size) tiles.push_back(i);
+#if OCTISO_WITH_MPI
+    return mpi::tiles_of_rank(tile_count, rank, size);   // the split gather_tiles() assumes
+#else
+    std::vector<int> tiles(size_t(std::max(tile_count, 0)));
+    for (int i = 0; i < tile_count; ++i) tiles[size_t(i)] = i;   // one rank renders every tile
     return tiles;
+#endif
 }
 
 RankExchange Ranks::gather_tiles([[maybe_unused]] const TileGrid& grid, [[maybe_unused]] bool colour,
