@@ -68,16 +68,14 @@ template <typename T> uint64_t brick_bytes(const Octree<T>& t, const CellBox& b)
         return true;
     };
     const auto visit = [&](auto&& self, int d, uint32_t index, const Coord& o) -> void {
-        if (d == t.dmax() - 1) {
-            bytes += sizeof(Cap<T>);
-            return;
-        }
         bytes += sizeof(InteriorNode<T>);
         const InteriorNode<T>& n = t.node(d, index);
         const uint32_t half = t.child_bit(d);
         for (int c = 0; c < 8; ++c) {
             const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
-            if (!n.is_scalar_leaf(c) && meets(co, half)) self(self, d + 1, n.child_index(c), co);
+            if (n.is_scalar_leaf(c) || !meets(co, half)) continue;
+            if (d + 1 == t.dmax() - 1) bytes += n.cap_bits;   // a packed cap (octree.h)
+            else self(self, d + 1, n.child_index(c), co);
         }
     };
     visit(visit, 0, 0, Coord{});

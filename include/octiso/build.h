@@ -35,9 +35,9 @@ struct BuildOptions {
 struct BuildStats {
     std::vector<uint64_t> nodes_per_depth;
     std::vector<uint64_t> scalar_leaves_per_depth;
-    uint64_t interior_bytes = 0;   ///< all InteriorNode records, min/max included
-    uint64_t minmax_bytes = 0;     ///< the part of interior_bytes that is min/max
-    uint64_t cap_bytes = 0;
+    uint64_t interior_bytes = 0;   ///< all InteriorNode records, bounds included
+    uint64_t minmax_bytes = 0;     ///< the part of interior_bytes that is child bounds
+    uint64_t cap_bytes = 0;        ///< packed cap records
     double seconds = 0;
 };
 
@@ -56,7 +56,9 @@ public:
     Dims dims;
     int dmax = 0;
     std::vector<UninitArray<InteriorNode<T>>> nodes;   ///< [depth 0 .. dmax-2]
-    UninitArray<Cap<T>> caps;
+    UninitArray<uint8_t> caps;    ///< packed cap records, then kCapReadSlack zero bytes
+    uint64_t cap_bytes = 0;       ///< records only
+    uint64_t cap_count = 0;
     BuildStats stats;
 };
 

@@ -1,18 +1,30 @@
 // Octree<T>: the read-only view of a lossless octree volume (Knoll et al. 2006, Sec. 4.1, App. A),
 // over memory owned elsewhere (an OctreeData built in memory, or an mmap'd .oct file). It owns the
-// node layout and the octree hashing of App. B: point location and neighbour finding with a
-// parent trace. Building lives in build.h, files in oct_file.h.
+// node layout, the packed caps and the octree hashing of App. B: point location and neighbour
+// finding with a parent trace. Building lives in build.h (packing in src/octree/pack.h), files in
+// oct_file.h.
 //
 // Index space: voxel (x,y,z) of the data, 0 <= x < dims.x (likewise y, z); the tree spans the
 // power-of-two cube [0, N)^3, N = 2^dmax >= max(dims), N >= 4. Depth d runs from 0 (root) to
 // dmax-1 (caps). A node at depth d covers a cube of side 2^(dmax-d); its children have side
 // child_bit(d) = 2^(dmax-d-1). Child octant c = x<<2 | y<<1 | z, where x = 1 for the upper half.
+//
+// The compact layout (issue 19; measured by `octiso-bench compression`, BENCHMARKS.md):
+//  - child bounds are quantized conservatively to 8 bits inside the node's own exact range
+//    (Knoll 2006 stored 8-bit min/max too); 1-byte scalars keep their exact bounds, which are
+//    no larger;
+//  - a cap is stored as 8 deltas of `cap_bits` bits from a base held in its parent's scalar slot
+//    (the base is the cap's smallest voxel, in the order of ScalarKey), all caps of one parent
+//    with the same width, so that a cap of b bits takes b bytes and is found by a multiply;
+//    where that saves nothing the cap is stored whole.
 #pragma once
 
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "octiso/inline.h"
 #include "octiso/volume.h"
@@ -21,39 +33,173 @@ namespace octiso {
 
 inline constexpr int kMaxDepth = 31;   ///< dmax <= 30 because extents are <= 2^30; one spare
 
+/// ScalarKey<T>: an unsigned integer of T's width whose order is the order of T's values (floats
+/// by their bit pattern, negatives reversed, -0 just below +0), so that cap deltas are lossless
+/// for every type, floats included.
+template <typename T> struct ScalarKey {
+    using Key = std::conditional_t<sizeof(T) == 1, uint8_t,
+                                   std::conditional_t<sizeof(T) == 2, uint16_t,
+                                                      std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>>>;
+    static constexpr Key kSign = Key(Key(1) << (8 * sizeof(T) - 1));
+    OCTISO_ALWAYS_INLINE static Key of(T v) {
+        const Key b = std::bit_cast<Key>(v);
+        if constexpr (std::is_floating_point_v<T>) return (b & kSign) ? Key(~b) : Key(b | kSign);
+        else if constexpr (std::is_signed_v<T>) return Key(b ^ kSign);
+        else return b;
+    }
+    OCTISO_ALWAYS_INLINE static T value(Key k) {
+        // Floats: a set top bit (positive) clears it, a clear one flips every bit; branch-free.
+        if constexpr (std::is_floating_point_v<T>) return std::bit_cast<T>(Key(k ^ (kSign | Key(Key(k >> (8 * sizeof(T) - 1)) - 1))));
+        else if constexpr (std::is_signed_v<T>) return std::bit_cast<T>(Key(k ^ kSign));
+        else return std::bit_cast<T>(k);
+    }
+};
+
+/// Bits of one voxel of a cap stored whole (no base, no deltas).
+template <typename T> inline constexpr unsigned kWholeCapBits = 8 * sizeof(T);
+/// Bytes of one cap record whose parent has `cap_bits`: 8 deltas of b bits are b bytes.
+template <typename T> constexpr uint64_t cap_record_bytes(unsigned cap_bits) { return cap_bits; }
+/// The widest delta a packed (not whole) cap may have: base + deltas must be smaller than the
+/// whole cap, and every delta must come out of one unaligned 64-bit load (shift <= 7).
+template <typename T> inline constexpr unsigned kMaxDeltaBits = 8 * sizeof(T) - 1 < 56 ? 8 * sizeof(T) - 1 : 56;
+/// A cap parent's first_child() is a 48-bit byte offset: the cap level of one step holds at most
+/// this many bytes (2^48, 256 TiB; interior levels keep 32-bit node indices).
+inline constexpr uint64_t kMaxCapByteOffset = uint64_t(1) << 48;
+/// Zero bytes after the last cap of a level, so that every delta is one 8-byte load in bounds.
+inline constexpr uint64_t kCapReadSlack = 8;
+
+/// ChildBounds<T>: [lower(c), upper(c)] contains the trilinear interpolant on every data cell
+/// whose lower corner lies in child c (the one-voxel forward layer +x,+y,+z counts). With no
+/// such cell (pure padding or the last data layer) the bounds are empty and traversal skips the
+/// child. 1-byte scalars: the exact min/max. Wider ones: 8-bit codes inside [lo, hi], the exact
+/// range of the node's children together; code q stands for lo + q * step (step = (hi - lo) /
+/// 255 as lo + q * ((hi - lo) * (1/255)), 0 is lo and 255 is hi exactly), the packer picks the
+/// largest lower code and the smallest upper code that still contain the true range (it runs
+/// this same decode), and qmin > qmax marks an empty child.
+template <typename T, bool kExact = (sizeof(T) == 1)> struct ChildBounds;
+
+template <typename T> struct ChildBounds<T, true> {
+    T min[8];
+    T max[8];
+    OCTISO_ALWAYS_INLINE bool empty(int c) const { return min[c] > max[c]; }
+    OCTISO_ALWAYS_INLINE double lower(int c) const { return double(min[c]); }
+    OCTISO_ALWAYS_INLINE double upper(int c) const { return double(max[c]); }
+    OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const { return double(min[c]) <= iso && iso <= double(max[c]); }
+    /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
+    double range_lo() const {
+        double v = std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 8; ++c) if (!empty(c) && double(min[c]) < v) v = double(min[c]);
+        return v;
+    }
+    double range_hi() const {
+        double v = -std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 8; ++c) if (!empty(c) && double(max[c]) > v) v = double(max[c]);
+        return v;
+    }
+};
+
+template <typename T> struct ChildBounds<T, false> {
+    T lo, hi;
+    uint8_t qmin[8];
+    uint8_t qmax[8];
+    static constexpr int kTop = 255;
+    OCTISO_ALWAYS_INLINE double step() const { return (double(hi) - double(lo)) * (1.0 / kTop); }
+    OCTISO_ALWAYS_INLINE double decode(int q, double step) const {
+        return q == 0 ? double(lo) : q == kTop ? double(hi) : double(lo) + double(q) * step;
+    }
+    OCTISO_ALWAYS_INLINE bool empty(int c) const { return qmin[c] > qmax[c]; }
+    OCTISO_ALWAYS_INLINE double lower(int c) const { return decode(qmin[c], step()); }
+    OCTISO_ALWAYS_INLINE double upper(int c) const { return decode(qmax[c], step()); }
+    OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const {
+        if (empty(c)) return false;
+        const double s = step();
+        return decode(qmin[c], s) <= iso && iso <= decode(qmax[c], s);
+    }
+    /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
+    double range_lo() const {
+        for (int c = 0; c < 8; ++c) if (!empty(c)) return double(lo);
+        return std::numeric_limits<double>::infinity();
+    }
+    double range_hi() const {
+        for (int c = 0; c < 8; ++c) if (!empty(c)) return double(hi);
+        return -std::numeric_limits<double>::infinity();
+    }
+};
+
 /// InteriorNode<T>: a node at depth d, 0 <= d <= dmax-2. For each child octant c:
 ///   child_mask bit c clear: child c is a scalar leaf; every voxel of it equals scalar[c]
 ///                           (padding beyond the data excepted: it is "don't care").
-///   child_mask bit c set:   child c is stored at depth d+1 (an InteriorNode, or a Cap when
-///                           d+1 == dmax-1) at index child_start + popcount(child_mask & ((1<<c)-1));
-///                           scalar[c] is then the midpoint of the child's data range.
-///   [min[c], max[c]] bounds the trilinear interpolant on every data cell whose lower corner lies
-///   in child c (so the one-voxel forward layer +x,+y,+z counts). With no such cell (pure padding
-///   or the last data layer) the range is empty: min[c] > max[c], and traversal skips the child.
-/// The loader validates child_start + popcount(child_mask) <= count at depth d+1 for every node.
+///   child_mask bit c set:   child c is stored at depth d+1. Below depth dmax-2 it is the
+///                           InteriorNode at index first_child() + rank(c) (rank: stored children
+///                           before c) and scalar[c] is the midpoint of its data range. At depth
+///                           dmax-2 it is a cap: its record starts at byte first_child() + rank(c)
+///                           * cap_record_bytes(cap_bits) of the caps, and scalar[c] is its base.
+///   bounds: ChildBounds above.
+/// The loader validates that the children of consecutive nodes follow each other exactly and
+/// stay inside the level below, and that cap_bits is kWholeCapBits or at most kMaxDeltaBits.
 template <typename T> struct InteriorNode {
-    T scalar[8];
-    T min[8];
-    T max[8];
-    uint32_t child_start;
+    uint32_t child_start;      ///< low 32 bits of first_child()
+    uint16_t child_start_hi;   ///< bits 32..47 (caps only: byte offsets; zero above depth dmax-2)
     uint8_t child_mask;
-    uint8_t reserved[3];
+    uint8_t cap_bits;          ///< depth dmax-2: bits per cap voxel; zero above
+    T scalar[8];
+    ChildBounds<T> bounds;
 
-    OCTISO_ALWAYS_INLINE bool is_scalar_leaf(int c) const { return ((child_mask >> c) & 1u) == 0; }
-    OCTISO_ALWAYS_INLINE uint32_t child_index(int c) const {
-        return child_start + uint32_t(std::popcount(unsigned(child_mask) & ((1u << c) - 1u)));
+    OCTISO_ALWAYS_INLINE uint64_t first_child() const { return uint64_t(child_start) | uint64_t(child_start_hi) << 32; }
+    void set_first_child(uint64_t v) {
+        child_start = uint32_t(v);
+        child_start_hi = uint16_t(v >> 32);
     }
-    OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const { return double(min[c]) <= iso && iso <= double(max[c]); }
+    OCTISO_ALWAYS_INLINE bool is_scalar_leaf(int c) const { return ((child_mask >> c) & 1u) == 0; }
+    OCTISO_ALWAYS_INLINE uint32_t rank(int c) const { return uint32_t(std::popcount(unsigned(child_mask) & ((1u << c) - 1u))); }
+    /// Index of stored child c at depth d+1 (d < dmax-2).
+    OCTISO_ALWAYS_INLINE uint32_t child_index(int c) const { return child_start + rank(c); }
+    /// Byte offset of cap child c among the caps (d == dmax-2).
+    OCTISO_ALWAYS_INLINE uint64_t cap_offset(int c) const { return first_child() + uint64_t(rank(c)) * cap_bits; }
+    OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const { return bounds.may_contain(c, iso); }
     OCTISO_ALWAYS_INLINE bool may_contain_any(int c, const double* isos, int count) const {
+        if (bounds.empty(c)) return false;
+        const double lo = bounds.lower(c), hi = bounds.upper(c);
         for (int i = 0; i < count; ++i)
-            if (may_contain(c, isos[i])) return true;
+            if (lo <= isos[i] && isos[i] <= hi) return true;
         return false;
     }
 };
 
-/// Cap<T>: the 2x2x2 voxels of a node at depth dmax-1, octant order as above.
+/// Cap<T>: the 2x2x2 voxels of a node at depth dmax-1, octant order as above; the builders' form
+/// of a cap before packing, and what CapRef decodes to.
 template <typename T> struct Cap {
     T voxel[8];
+};
+
+/// Where one packed cap lives: its record, its parent's width and its base.
+template <typename T> struct CapRef {
+    const uint8_t* record = nullptr;
+    unsigned bits = 0;
+    T base{};
+
+    /// Voxel k (octant order).
+    OCTISO_ALWAYS_INLINE T voxel(int k) const {
+        if (bits == kWholeCapBits<T>) {
+            T v;
+            std::memcpy(&v, record + size_t(k) * sizeof(T), sizeof(T));
+            return v;
+        }
+        const unsigned pos = unsigned(k) * bits;
+        uint64_t word;
+        std::memcpy(&word, record + (pos >> 3), 8);   // in bounds: kCapReadSlack
+        const uint64_t delta = (word >> (pos & 7u)) & ((uint64_t(1) << bits) - 1u);
+        using K = ScalarKey<T>;
+        return K::value(typename K::Key(K::of(base) + delta));
+    }
+    /// All 8 voxels.
+    OCTISO_ALWAYS_INLINE void decode(T out[8]) const {
+        if (bits == kWholeCapBits<T>) {
+            std::memcpy(out, record, 8 * sizeof(T));
+            return;
+        }
+        for (int k = 0; k < 8; ++k) out[k] = voxel(k);
+    }
 };
 
 /// Integer point in index space.
@@ -68,12 +214,18 @@ OCTISO_ALWAYS_INLINE int octant_of(Coord p, uint32_t child_bit) {
 }
 
 /// Where point location ended: the value, the depth of the node that holds it, and whether it is
-/// a cap voxel (side 1) or a scalar leaf child of an interior node (side child_bit(depth)).
+/// a cap voxel (side 1; `cap` is then that cap) or a scalar leaf child of an interior node (side
+/// child_bit(depth)).
 template <typename T> struct LeafRef {
-    T value;
+    T value;            ///< a scalar leaf's value (in_cap: see voxel())
     int depth;          ///< depth of the holding node (cap: dmax-1)
-    uint32_t index;     ///< index of the holding node at that depth
     bool in_cap;
+    CapRef<T> cap;      ///< in_cap only
+    int octant = 0;     ///< in_cap only: the voxel's octant in the cap
+
+    /// The located voxel's value; a cap voxel is decoded only here, so a caller that wants the
+    /// whole block (the traversal's neighbour blocks) pays for no decode it does not use.
+    OCTISO_ALWAYS_INLINE T voxel() const { return in_cap ? cap.voxel(octant) : value; }
 };
 
 /// Per-depth arrays of one octree; the view's raw material. Pointers stay owned by the creator.
@@ -82,7 +234,8 @@ template <typename T> struct OctreeArrays {
     int dmax = 0;
     std::array<const InteriorNode<T>*, kMaxDepth> nodes{};   ///< depth 0 .. dmax-2
     std::array<uint64_t, kMaxDepth> node_count{};
-    const Cap<T>* caps = nullptr;                            ///< depth dmax-1
+    const uint8_t* caps = nullptr;   ///< depth dmax-1: packed cap records, then kCapReadSlack zero bytes
+    uint64_t cap_bytes = 0;          ///< records only (the slack not counted)
     uint64_t cap_count = 0;
 };
 
@@ -99,33 +252,38 @@ public:
     uint32_t child_bit(int d) const { return 1u << (a_.dmax - d - 1); }
     uint64_t node_count(int d) const { return a_.node_count[size_t(d)]; }
     uint64_t cap_count() const { return a_.cap_count; }
+    uint64_t cap_bytes() const { return a_.cap_bytes; }
     const InteriorNode<T>& node(int d, uint64_t i) const { return a_.nodes[size_t(d)][i]; }
-    const Cap<T>& cap(uint64_t i) const { return a_.caps[i]; }
+    /// Cap child c of `parent`, a node at depth dmax-2.
+    OCTISO_ALWAYS_INLINE CapRef<T> cap(const InteriorNode<T>& parent, int c) const {
+        return {a_.caps + parent.cap_offset(c), parent.cap_bits, parent.scalar[c]};
+    }
     const OctreeArrays<T>& arrays() const { return a_; }
 
-    /// Value of voxel p, starting the descent at node `index` of depth `depth` (a cap when depth
-    /// == dmax-1). Precondition: p lies inside that node's cube. Knoll 2006 App. B.1, with the
-    /// child octant built by bitwise or (the paper's `||` is a slip).
+    /// Value of voxel p, starting the descent at node `index` of depth `depth` <= dmax-2.
+    /// Precondition: p lies inside that node's cube. Knoll 2006 App. B.1, with the child octant
+    /// built by bitwise or (the paper's `||` is a slip).
     OCTISO_ALWAYS_INLINE LeafRef<T> locate_from(Coord p, int depth, uint32_t index) const {
-        const int caps_at = a_.dmax - 1;
+        const int cap_parents_at = a_.dmax - 2;
         for (;;) {
-            if (depth == caps_at) return {a_.caps[index].voxel[octant_of(p, 1u)], depth, index, true};
             const InteriorNode<T>& n = a_.nodes[size_t(depth)][index];
             const int c = octant_of(p, child_bit(depth));
-            if (n.is_scalar_leaf(c)) return {n.scalar[c], depth, index, false};
+            if (n.is_scalar_leaf(c)) return {n.scalar[c], depth, false, {}, 0};
+            if (depth == cap_parents_at) return {T{}, depth + 1, true, this->cap(n, c), octant_of(p, 1u)};
             index = n.child_index(c);
             ++depth;
         }
     }
     LeafRef<T> locate(Coord p) const { return locate_from(p, 0, 0); }
-    T point_locate(Coord p) const { return locate_from(p, 0, 0).value; }
+    T point_locate(Coord p) const { return locate_from(p, 0, 0).voxel(); }
 
     /// Value at `dest`, given the trace of node indices from the root down to the node that holds
-    /// `start`: parent_trace[d] is the node at depth d containing `start`, for d = 0 .. depth.
+    /// `start`: parent_trace[d] is the node at depth d containing `start`, for d = 0 .. depth
+    /// (depth <= dmax-2; a cap's corners outside it start from its parent).
     /// Climbs to the deepest traced node whose cube also contains `dest`, then locates down
     /// (Knoll 2006 App. B.2; the paper's trailing root check is folded into the loop at d = 0).
     OCTISO_ALWAYS_INLINE T neighbour_find(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
-        return neighbour_locate(start, dest, depth, parent_trace).value;
+        return neighbour_locate(start, dest, depth, parent_trace).voxel();
     }
     /// The same, returning where the descent ended (the traversal then reads a whole forward
     /// neighbour block directly).

@@ -10,6 +10,8 @@
 //   mixing          Richtmyer-Meshkov-like mixing layer: 255 below, 0 above, a perturbed,
 //                   multi-scale mixing band between them (u8)
 //   plume-series    the plume at time step k (k = 0 is `plume`)
+//   ct-head         CT-like head in Hounsfield units: air, soft tissue, porous skull, brain,
+//                   ventricles, 12 HU of scanner noise everywhere (i16)
 //
 // Values sit on the generator's natural scale; an integer T gets them multiplied by the
 // generator's integer scale (255 for marschner-lobb, else 1), rounded and clamped to T's range.

@@ -62,15 +62,10 @@ public:
     StepSizes sizes() const override { return sizes_; }
 
     std::optional<std::array<double, 2>> value_range() const override {
-        // The root is always stored (dmax >= 2), and its 8 child ranges together cover every
-        // data cell; an empty child range (min > max) covers none.
-        const InteriorNode<T>& root = tree_.node(0, 0);
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (int c = 0; c < 8; ++c)
-            if (!(root.max[c] < root.min[c])) {
-                lo = std::min(lo, double(root.min[c]));
-                hi = std::max(hi, double(root.max[c]));
-            }
+        // The root is always stored (dmax >= 2), and its children's exact range together
+        // covers every data cell (octree.h, ChildBounds: kept exact per node).
+        const ChildBounds<T>& root = tree_.node(0, 0).bounds;
+        const double lo = root.range_lo(), hi = root.range_hi();
         if (lo > hi) return std::nullopt;
         return std::array<double, 2>{lo, hi};
     }

@@ -56,10 +56,11 @@ void walk_node(const Octree<T>& tree, int depth, uint64_t index, uint32_t x0, ui
             const uint64_t n = uint64_t(std::min(s, dims.x - x)) * std::min(s, dims.y - y) * std::min(s, dims.z - z);
             visit(node.scalar[c], n);
         } else if (depth + 1 == tree.cap_depth()) {
-            const Cap<T>& cap = tree.cap(node.child_index(c));
+            T voxel[8];
+            tree.cap(node, c).decode(voxel);
             for (int o = 0; o < 8; ++o)
                 if (x + ((o >> 2) & 1) < dims.x && y + ((o >> 1) & 1) < dims.y && z + (o & 1) < dims.z)
-                    visit(cap.voxel[o], 1);
+                    visit(voxel[o], 1);
         } else {
             walk_node(tree, depth + 1, node.child_index(c), x, y, z, visit);
         }

@@ -145,10 +145,13 @@ private:
                 for (int l = 0; l < levels_; ++l) {
                     const int d = k_ + l;
                     const bool caps = d == dmax_ - 1;
-                    const uint64_t n = caps ? s.caps.size() : s.nodes[size_t(d)].size();
+                    const uint64_t n = caps ? s.caps.size() : s.nodes[size_t(d)].size();   // caps: bytes
                     OCTISO_CHECK(n <= UINT32_MAX, "piece of ", n, " records at depth ", d);
                     counts_[size_t(l)][first + i] = uint32_t(n);
-                    if (caps) spill_[size_t(l)]->append(s.caps.data(), n * sizeof(Cap<T>));
+                    if (caps) {
+                        spill_[size_t(l)]->append(s.caps.data(), n);
+                        cap_count_ += s.cap_count;
+                    }
                     else spill_[size_t(l)]->append(s.nodes[size_t(d)].data(), n * sizeof(InteriorNode<T>));
                     leaves_[size_t(d)] += s.leaves[size_t(d)];
                 }
@@ -201,12 +204,14 @@ private:
     void place_children(InteriorNode<T>& n, uint64_t base, uint64_t& expected, uint64_t next_count, int d) const {
         // Every node is offset, childless ones too: build.cpp's concatenation does so, and a
         // childless node's child_start is then where its children would start (the same bytes).
-        const uint64_t global = uint64_t(n.child_start) + base;
-        const uint64_t end = global + uint64_t(std::popcount(unsigned(n.child_mask)));
-        if (end > (uint64_t(1) << 32))
-            throw Error(options_.source_name, "octree too large: more than 2^32 nodes at depth " + std::to_string(d + 1) +
-                                                  " (32-bit child indices)");
-        n.child_start = uint32_t(global);
+        const bool caps_below = d + 1 == dmax_ - 1;   // then offsets and counts are bytes
+        const uint64_t global = n.first_child() + base;
+        const uint64_t end = global + uint64_t(std::popcount(unsigned(n.child_mask))) * (caps_below ? n.cap_bits : 1u);
+        if (end > (caps_below ? kMaxCapByteOffset : uint64_t(1) << 32))
+            throw Error(options_.source_name, caps_below ? "octree too large: more than 2^48 bytes of caps"
+                                                         : "octree too large: more than 2^32 nodes at depth " +
+                                                               std::to_string(d + 1) + " (32-bit child indices)");
+        n.set_first_child(global);
         if (n.child_mask == 0) return;
         OCTISO_CHECK(global == expected && end <= next_count, "depth ", d, ": children from ", global, " (expected ",
                      expected, ") past ", next_count, " at depth ", d + 1);
@@ -230,15 +235,15 @@ private:
             sizes.scalar_leaves_per_depth.push_back(top.leaves[size_t(d)]);
         }
         std::vector<InteriorNode<T>> nodes;
-        std::vector<Cap<T>> caps;
+        std::vector<uint8_t> caps;
         std::vector<uint64_t> at(n_pieces_);   // record offset of each piece's chunk in its spill file
         for (int l = 0; l < levels_; ++l) {
             const int d = k_ + l;
             const bool is_caps = d == dmax_ - 1;
-            const size_t record = is_caps ? sizeof(Cap<T>) : sizeof(InteriorNode<T>);
+            const size_t record = is_caps ? 1 : sizeof(InteriorNode<T>);   // the cap level counts bytes
             uint64_t acc = 0;
             for (uint64_t id = 0; id < n_pieces_; ++id) at[id] = acc, acc += counts_[size_t(l)][id];
-            writer_.begin_section(d, total[size_t(d)]);
+            writer_.begin_section(d, total[size_t(d)] + (is_caps ? kCapReadSlack : 0));
             uint64_t base = 0, expected = 0;
             for (const uint64_t id : order) {
                 const uint64_t n = counts_[size_t(l)][id];
@@ -257,13 +262,18 @@ private:
             if (!is_caps)
                 OCTISO_CHECK(expected == total[size_t(d + 1)], "depth ", d, " has children for ", expected, " of ",
                              total[size_t(d + 1)], " nodes");
+            if (is_caps) {
+                static constexpr uint8_t kSlack[kCapReadSlack] = {};
+                writer_.append_records(kSlack, kCapReadSlack);
+            }
             writer_.end_section();
             sizes.scalar_leaves_per_depth.push_back(leaves_[size_t(d)]);
         }
         sizes.nodes_per_depth = total;
         for (int d = 0; d + 1 < dmax_; ++d) sizes.interior_bytes += total[size_t(d)] * sizeof(InteriorNode<T>);
-        sizes.minmax_bytes = sizes.interior_bytes / sizeof(InteriorNode<T>) * 16 * sizeof(T);
-        sizes.cap_bytes = total[size_t(dmax_ - 1)] * sizeof(Cap<T>);
+        sizes.minmax_bytes = sizes.interior_bytes / sizeof(InteriorNode<T>) * sizeof(ChildBounds<T>);
+        sizes.cap_bytes = total[size_t(dmax_ - 1)];
+        sizes.nodes_per_depth[size_t(dmax_ - 1)] = cap_count_;
         return sizes;
     }
 
@@ -280,6 +290,7 @@ private:
     std::vector<std::vector<uint32_t>> counts_;   // [depth - k][piece id]: records of each piece
     std::vector<Summary<T>> roots_;               // [piece id]
     std::vector<uint64_t> leaves_;                // scalar leaves per depth, pieces' depths only
+    uint64_t cap_count_ = 0;                      // caps (counts_ holds their bytes)
     SpillAllowance allowance_;
     std::vector<std::unique_ptr<SpillFile>> spill_;   // [depth - k]
 };

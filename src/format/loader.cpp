@@ -84,9 +84,10 @@ struct OctFile::Impl {
             a.nodes[size_t(d)] = reinterpret_cast<const InteriorNode<T>*>(base + s.offset);
             a.node_count[size_t(d)] = s.count;
         }
-        const SectionEntry& c = section(k, info.dmax - 1);
-        a.caps = reinterpret_cast<const Cap<T>*>(base + c.offset);
-        a.cap_count = c.count;
+        const SectionEntry& c = section(k, info.dmax - 1);   // count >= kCapReadSlack (check_table)
+        a.caps = reinterpret_cast<const uint8_t*>(base + c.offset);
+        a.cap_bytes = c.count - kCapReadSlack;
+        a.cap_count = 0;   // counted by validate_tree from the cap parents
         return a;
     }
 
@@ -148,6 +149,9 @@ void OctFile::Impl::check_header() {
     if (h.version == 1)
         fail("is .oct format version 1, written before value scaling and flipped axes were recorded (a NIfTI "
              "source may be stored unscaled): convert the source again with octiso-convert");
+    if (h.version == 2)
+        fail("is .oct format version 2, the node layout before compact nodes and packed caps (format 3): convert "
+             "the source again with octiso-convert");
     if (h.version != format::kFormatVersion)
         fail("unsupported format version (expected " + num(format::kFormatVersion) + ", found " + num(h.version) + ")");
     if (h.header_bytes != sizeof(FileHeader))
@@ -246,6 +250,9 @@ void OctFile::Impl::check_table() {
                  " bytes, found " + num(s.bytes) + ")");
         if (depth == 0 && s.count != 1)
             fail(name + ": the root level must hold exactly one node (expected 1, found " + num(s.count) + ")");
+        if (is_caps && s.count < kCapReadSlack)
+            fail(name + ": the cap level must end with " + num(kCapReadSlack) + " zero bytes (found " + num(s.count) +
+                 " bytes in all)");
         // Canonical placement: right after the previous region, at the next multiple of 64,
         // with zero padding in between (so no byte of the file escapes every check).
         const uint64_t at = format::align_up(end);
@@ -302,8 +309,10 @@ template <typename T> Octree<T> OctFile::step(uint32_t k) const {
     if (scalar_type_of<T>() != impl_->info.type)
         impl_->fail("holds " + std::string(scalar_type_name(impl_->info.type)) + " data, requested as " +
                     std::string(scalar_type_name(scalar_type_of<T>())));
-    impl_->ensure_valid(k);
-    return Octree<T>(impl_->arrays<T>(k));
+    const StepSizes& sizes = impl_->ensure_valid(k);
+    OctreeArrays<T> a = impl_->arrays<T>(k);
+    a.cap_count = sizes.nodes_per_depth[size_t(a.dmax - 1)];
+    return Octree<T>(a);
 }
 
 StepSizes OctFile::step_sizes(uint32_t k) const { return impl_->ensure_valid(k); }

@@ -28,10 +28,10 @@
 //              | step 0, depth 1:        InteriorNode<T>[n1]                  |
 //              |   ...                                                        |
 //              | step 0, depth dmax-2:   InteriorNode<T>[n(dmax-2)]           |
-//              | step 0, depth dmax-1:   Cap<T>[n_caps]                       |
+//              | step 0, depth dmax-1:   packed caps (bytes), 8 zero bytes    |
 //              | step 1, depth 0 ...     (each section starts at the next     |
 //              |   ...                    multiple of 64; gaps are zero)      |
-//              | step S-1, depth dmax-1: Cap<T>[...]                          |
+//              | step S-1, depth dmax-1: packed caps ...                      |
 //              +-------------------------------------------------------------+
 //              | SectionEntry[S * dmax]  (64-aligned, in (step, depth) order) |
 //  file_bytes  +-------------------------------------------------------------+
@@ -41,12 +41,21 @@
 //  with the table. So every byte of the file is covered by a checksum or must be zero, and a
 //  single flipped bit anywhere is detected (Verify::Full).
 //
-//  InteriorNode<T> record (24*sizeof(T) + 8 bytes, no padding):
-//    +-----------+---------+---------+-------------+------------+-------------+
-//    | scalar[8] | min[8]  | max[8]  | child_start | child_mask | reserved[3] |
-//    | 8 T       | 8 T     | 8 T     | u32         | u8         | zero        |
-//    +-----------+---------+---------+-------------+------------+-------------+
-//  Cap<T> record: voxel[8], 8*sizeof(T) bytes. Octant c = x<<2 | y<<1 | z.
+//  InteriorNode<T> record (format 3, issue 19; s = sizeof(T)), no padding:
+//    +-------------+----------------+------------+----------+-----------+------------------------+
+//    | child_start | child_start_hi | child_mask | cap_bits | scalar[8] | bounds                 |
+//    | u32         | u16            | u8         | u8       | 8 T       | s == 1: min[8], max[8] |
+//    |             | (caps: byte    |            | (dmax-2  |           |   (8 T each, exact)    |
+//    |             |  offset bits   |            |  only)   |           | s > 1: lo, hi (T),     |
+//    |             |  32..47)       |            |          |           |   qmin[8], qmax[8] (u8)|
+//    +-------------+----------------+------------+----------+-----------+------------------------+
+//    32 bytes for 1-byte scalars, 44 for 2, 64 for 4, 104 for 8 (format 2: 24 s + 8).
+//  Caps section: a byte array (record_bytes 1, count = its bytes). The caps of one depth dmax-2
+//  parent follow each other from its first_child() byte, each cap_bits bytes: 8 deltas of
+//  cap_bits bits, little-endian bit order, voxel k at bits [k b, (k+1) b) of the record, added to
+//  the key (ScalarKey) of the parent's scalar[c]; cap_bits == 8 s: the 8 voxels stored whole.
+//  The section ends with kCapReadSlack zero bytes (every delta is one 8-byte load). Octant
+//  c = x<<2 | y<<1 | z.
 // ---------------------------------------------------------------------------------------------
 
 namespace octiso::format {
@@ -57,7 +66,9 @@ static_assert(std::endian::native == std::endian::little,
 inline constexpr char kMagic[8] = {'O', 'C', 'T', 'I', 'S', 'O', '\0', '\x1a'};
 /// 2: value slope/intercept and flipped axes (NIfTI scl_slope/scl_inter and negative affine
 /// axes, issue 17). Version 1 files are refused: they may hold NIfTI data stored unscaled.
-inline constexpr uint32_t kFormatVersion = 2;
+/// 3: the compact node layout and packed caps (issue 19). Version 2 files are refused with a
+/// message to convert again (their records are not this layout).
+inline constexpr uint32_t kFormatVersion = 3;
 inline constexpr uint32_t kEndianTag = 0x01020304u;   ///< reads back as 0x04030201 if swapped
 inline constexpr uint64_t kSectionAlign = 64;
 
@@ -124,20 +135,22 @@ static_assert(offsetof(SectionEntry, offset) == 16 && offsetof(SectionEntry, che
 /// The node records are written as raw bytes: their size must be exactly the drawing above.
 template <typename T> constexpr bool record_layout_ok() {
     using N = InteriorNode<T>;
+    constexpr size_t s = sizeof(T);
     return std::is_trivially_copyable_v<N> && std::is_standard_layout_v<N> &&
-           sizeof(N) == 24 * sizeof(T) + 8 && offsetof(N, min) == 8 * sizeof(T) &&
-           offsetof(N, max) == 16 * sizeof(T) && offsetof(N, child_start) == 24 * sizeof(T) &&
-           offsetof(N, child_mask) == 24 * sizeof(T) + 4 && offsetof(N, reserved) == 24 * sizeof(T) + 5 &&
-           std::is_trivially_copyable_v<Cap<T>> && sizeof(Cap<T>) == 8 * sizeof(T) &&
-           alignof(N) <= kSectionAlign && alignof(Cap<T>) <= kSectionAlign;
+           sizeof(N) == 8 + 8 * s + (s == 1 ? 16 : 2 * s + 16) && offsetof(N, child_start_hi) == 4 &&
+           offsetof(N, child_mask) == 6 && offsetof(N, cap_bits) == 7 && offsetof(N, scalar) == 8 &&
+           offsetof(N, bounds) == 8 + 8 * s && alignof(N) <= kSectionAlign;
 }
 static_assert(record_layout_ok<uint8_t>() && record_layout_ok<int8_t>() && record_layout_ok<uint16_t>() &&
               record_layout_ok<int16_t>() && record_layout_ok<uint32_t>() && record_layout_ok<int32_t>() &&
               record_layout_ok<float>() && record_layout_ok<double>());
 
-/// Size of one record of each kind for a scalar of `scalar_bytes` bytes (1, 2, 4 or 8).
-inline constexpr uint64_t interior_record_bytes(uint64_t scalar_bytes) { return 24 * scalar_bytes + 8; }
-inline constexpr uint64_t cap_record_bytes(uint64_t scalar_bytes) { return 8 * scalar_bytes; }
+/// Size of one record of each kind for a scalar of `scalar_bytes` bytes (1, 2, 4 or 8); the cap
+/// level is a byte array.
+inline constexpr uint64_t interior_record_bytes(uint64_t scalar_bytes) {
+    return 8 + 8 * scalar_bytes + (scalar_bytes == 1 ? 16 : 2 * scalar_bytes + 16);
+}
+inline constexpr uint64_t cap_record_bytes(uint64_t) { return 1; }
 
 /// Next multiple of 64 at or above `x`; callers keep x far below 2^64 (checked before use).
 inline constexpr uint64_t align_up(uint64_t x) { return (x + kSectionAlign - 1) & ~(kSectionAlign - 1); }

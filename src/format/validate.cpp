@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <new>
 #include <bit>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <vector>
@@ -47,7 +48,8 @@ std::string where(uint32_t step, int depth, int dmax) {
 struct ChunkResult {
     std::optional<uint64_t> first_parent;   ///< first node in the chunk with children
     uint64_t first_start = 0;               ///< its child_start
-    uint64_t children = 0;                  ///< sum of popcount(child_mask) over the chunk
+    uint64_t children = 0;                  ///< what the chunk's children take below: nodes, or cap bytes
+    uint64_t stored = 0;                    ///< sum of popcount(child_mask) over the chunk
     uint64_t leaves = 0;                    ///< sum of 8 - popcount
     std::optional<uint64_t> bad_node;       ///< first node failing a local check
     std::string problem;
@@ -55,27 +57,49 @@ struct ChunkResult {
 
 constexpr uint64_t kChunk = 1u << 15;
 
+/// The node's own fields (format 3, octree.h): the cap width where caps lie below, zero high
+/// offset bits and zero width elsewhere, ordered finite bounds. Empty when they are fine.
+template <typename T> std::string field_problem(const InteriorNode<T>& n, bool caps_below) {
+    if (caps_below) {
+        if (n.cap_bits != kWholeCapBits<T> && n.cap_bits > kMaxDeltaBits<T>)
+            return "cap_bits out of range (expected 0 .. " + std::to_string(kMaxDeltaBits<T>) + " or " +
+                   std::to_string(kWholeCapBits<T>) + ", found " + std::to_string(n.cap_bits) + ")";
+    } else if (n.cap_bits != 0 || n.child_start_hi != 0) {
+        return "cap_bits and child_start_hi must be zero above the cap parents (found " + std::to_string(n.cap_bits) +
+               " and " + std::to_string(n.child_start_hi) + ")";
+    }
+    if constexpr (sizeof(T) > 1) {
+        const double lo = double(n.bounds.lo), hi = double(n.bounds.hi);
+        if (!(std::isfinite(lo) && std::isfinite(hi) && lo <= hi))
+            return "bounds range is not finite and ordered (found lo " + std::to_string(lo) + ", hi " +
+                   std::to_string(hi) + ")";
+    }
+    return {};
+}
+
 template <typename T>
 ChunkResult check_chunk(const InteriorNode<T>* nodes, uint64_t begin, uint64_t end, uint64_t next_count,
-                        const char* next_name) {
+                        const char* next_name, bool caps_below) {
     ChunkResult r;
     uint64_t expected_start = 0;   // where the next node with children must start (after the first)
     for (uint64_t i = begin; i < end; ++i) {
         const InteriorNode<T>& n = nodes[i];
         const uint64_t pc = uint64_t(std::popcount(unsigned(n.child_mask)));
-        const uint64_t start = n.child_start;
+        const uint64_t span = pc * (caps_below ? n.cap_bits : 1u);   // bytes of caps, or nodes
+        const uint64_t start = n.first_child();
         auto fail = [&](std::string problem) {
             r.bad_node = i;
             r.problem = std::move(problem);
         };
-        if (n.reserved[0] | n.reserved[1] | n.reserved[2]) {
-            fail("reserved bytes are not zero");
+        if (std::string p = field_problem(n, caps_below); !p.empty()) {
+            fail(std::move(p));
             return r;
         }
-        if (start + pc > next_count) {
-            fail("child_start + popcount(child_mask) runs past the " + std::to_string(next_count) + " " + next_name +
+        if (start + span > next_count) {
+            const char* what = caps_below ? "first_child + popcount(child_mask) x cap_bits" : "child_start + popcount(child_mask)";
+            fail(std::string(what) + " runs past the " + std::to_string(next_count) + " " + next_name +
                  " below (expected <= " + std::to_string(next_count) + ", found " + std::to_string(start) + " + " +
-                 std::to_string(pc) + " = " + std::to_string(start + pc) + ")");
+                 std::to_string(span) + " = " + std::to_string(start + span) + ")");
             return r;
         }
         if (pc != 0) {
@@ -89,9 +113,10 @@ ChunkResult check_chunk(const InteriorNode<T>* nodes, uint64_t begin, uint64_t e
                      ")");
                 return r;
             }
-            expected_start = start + pc;
+            expected_start = start + span;
         }
-        r.children += pc;
+        r.children += span;
+        r.stored += pc;
         r.leaves += 8 - pc;
     }
     return r;
@@ -117,14 +142,18 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
     if (a.node_count[0] != 1)
         throw Error(subject, where(step, 0, dmax) + ": the root level must hold exactly one node (expected 1, found " +
                                  std::to_string(a.node_count[0]) + ")");
-    // Node indices are 32-bit (child_start, child_index()), so no depth may hold more than 2^32.
+    // Node indices are 32-bit (child_start, child_index()), so no depth may hold more than 2^32;
+    // caps are found by 48-bit byte offsets.
     constexpr uint64_t kMaxPerDepth = uint64_t(1) << 32;
-    for (int d = 1; d < dmax; ++d) {
-        const uint64_t n = d == dmax - 1 ? a.cap_count : a.node_count[size_t(d)];
+    for (int d = 1; d + 1 < dmax; ++d) {
+        const uint64_t n = a.node_count[size_t(d)];
         if (n > kMaxPerDepth)
             throw Error(subject, where(step, d, dmax) + ": too many records for 32-bit child indices (expected <= " +
                                      std::to_string(kMaxPerDepth) + ", found " + std::to_string(n) + ")");
     }
+    if (a.cap_bytes > kMaxCapByteOffset)
+        throw Error(subject, where(step, dmax - 1, dmax) + ": too many bytes for 48-bit cap offsets (expected <= " +
+                                 std::to_string(kMaxCapByteOffset) + ", found " + std::to_string(a.cap_bytes) + ")");
     StepSizes sizes;
     sizes.nodes_per_depth.assign(size_t(dmax), 0);
     sizes.scalar_leaves_per_depth.assign(size_t(dmax), 0);
@@ -132,7 +161,7 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
     for (int d = 0; d <= dmax - 2; ++d) {
         const uint64_t count = a.node_count[size_t(d)];
         const bool next_is_caps = d + 1 == dmax - 1;
-        const uint64_t next_count = next_is_caps ? a.cap_count : a.node_count[size_t(d + 1)];
+        const uint64_t next_count = next_is_caps ? a.cap_bytes : a.node_count[size_t(d + 1)];
         const InteriorNode<T>* nodes = a.nodes[size_t(d)];
         if (count != 0 && nodes == nullptr)
             throw Error(subject, where(step, d, dmax) + ": " + std::to_string(count) + " nodes but no data");
@@ -140,16 +169,16 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
         // 2. Local checks per chunk in parallel, each chunk stopping at its first bad node.
         const uint64_t n_chunks = (count + kChunk - 1) / kChunk;
         std::vector<ChunkResult> chunks(n_chunks);
-        const char* next_name = next_is_caps ? "caps" : "nodes";
+        const char* next_name = next_is_caps ? "bytes of caps" : "nodes";
         tbb::parallel_for(uint64_t(0), n_chunks, [&](uint64_t c) {
             const uint64_t begin = c * kChunk;
             const uint64_t end = std::min(count, begin + kChunk);
-            chunks[c] = check_chunk(nodes, begin, end, next_count, next_name);
+            chunks[c] = check_chunk(nodes, begin, end, next_count, next_name, next_is_caps);
         });
 
         // 3. Stitch: each chunk's first children start where the previous chunks' children end;
         // the earliest failing node (local or boundary) is the one reported.
-        uint64_t covered = 0, leaves = 0;
+        uint64_t covered = 0, leaves = 0, stored = 0;
         for (const ChunkResult& r : chunks) {
             if (r.first_parent && r.first_start != covered && (!r.bad_node || *r.first_parent < *r.bad_node))
                 throw Error(subject, where(step, d, dmax) + ", node " + std::to_string(*r.first_parent) + ": " +
@@ -160,6 +189,7 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
             if (r.bad_node) throw Error(subject, where(step, d, dmax) + ", node " + std::to_string(*r.bad_node) + ": " + r.problem);
             covered += r.children;
             leaves += r.leaves;
+            stored += r.stored;
         }
         if (covered != next_count)
             throw Error(subject, where(step, d + 1, dmax) + ": the parents' child masks do not cover the level exactly (expected " +
@@ -168,12 +198,15 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
         sizes.nodes_per_depth[size_t(d)] = count;
         sizes.scalar_leaves_per_depth[size_t(d)] = leaves;
         sizes.interior_bytes += count * sizeof(InteriorNode<T>);
-        sizes.minmax_bytes += count * 16 * sizeof(T);
+        sizes.minmax_bytes += count * sizeof(ChildBounds<T>);
+        if (next_is_caps) sizes.nodes_per_depth[size_t(dmax - 1)] = stored;
     }
-    if (a.cap_count != 0 && a.caps == nullptr)
-        throw Error(subject, where(step, dmax - 1, dmax) + ": " + std::to_string(a.cap_count) + " caps but no data");
-    sizes.nodes_per_depth[size_t(dmax - 1)] = a.cap_count;
-    sizes.cap_bytes = a.cap_count * sizeof(Cap<T>);
+    if (a.caps == nullptr) throw Error(subject, where(step, dmax - 1, dmax) + ": no cap level");
+    for (uint64_t i = 0; i < kCapReadSlack; ++i)
+        if (a.caps[a.cap_bytes + i] != 0)
+            throw Error(subject, where(step, dmax - 1, dmax) + ": the " + std::to_string(kCapReadSlack) +
+                                     " bytes after the last cap are not zero");
+    sizes.cap_bytes = a.cap_bytes;
     return sizes;
 }
 

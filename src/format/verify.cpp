@@ -76,21 +76,22 @@ template <typename T> struct Walker {
                     if (vmax < a || vmin > b) check = false;
                     vmin = std::max(vmin, a), vmax = std::min(vmax, b);
                 }
-                const double smin = double(node.min[c]), smax = double(node.max[c]);
+                const double smin = node.bounds.empty(c) ? INFINITY : node.bounds.lower(c);
+                const double smax = node.bounds.empty(c) ? -INFINITY : node.bounds.upper(c);
                 const double tol = info.tolerance;   // lossy files: leaves are within tol of the data
                 if (check && !(smin - tol <= vmin && vmax <= smax + tol))
                     lie(d, i, c, "stored range [" + std::to_string(smin) + ", " + std::to_string(smax) +
                                      "] does not contain the values of its cells [" + std::to_string(vmin) + ", " +
                                      std::to_string(vmax) + "]");
             }
-            if (node.is_scalar_leaf(c)) continue;
+            if (node.is_scalar_leaf(c) || d + 1 == tree.cap_depth()) continue;   // a cap's scalar is its base
             // An interior child's scalar is the midpoint of its range: inside the stored range.
             const double s = double(node.scalar[c]);
-            if (has_cells && std::isfinite(s) && node.min[c] <= node.max[c] &&
-                !(double(node.min[c]) <= s && s <= double(node.max[c])))
-                lie(d, i, c, "scalar " + std::to_string(s) + " lies outside its range [" + std::to_string(double(node.min[c])) +
-                                 ", " + std::to_string(double(node.max[c])) + "]");
-            if (d + 1 < tree.cap_depth()) walk(d + 1, node.child_index(c), lo);
+            if (has_cells && std::isfinite(s) && !node.bounds.empty(c) &&
+                !(node.bounds.lower(c) <= s && s <= node.bounds.upper(c)))
+                lie(d, i, c, "scalar " + std::to_string(s) + " lies outside its range [" +
+                                 std::to_string(node.bounds.lower(c)) + ", " + std::to_string(node.bounds.upper(c)) + "]");
+            walk(d + 1, node.child_index(c), lo);
         }
     }
 };

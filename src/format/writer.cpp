@@ -124,7 +124,7 @@ template <typename T> void OctWriter::add_step(const Octree<T>& octree) {
     for (int d = 0; d + 1 < a.dmax; ++d)
         m.add_section(format::SectionKind::Interior, step, d, uint32_t(sizeof(InteriorNode<T>)), a.nodes[size_t(d)],
                       a.node_count[size_t(d)]);
-    m.add_section(format::SectionKind::Caps, step, a.dmax - 1, uint32_t(sizeof(Cap<T>)), a.caps, a.cap_count);
+    m.add_section(format::SectionKind::Caps, step, a.dmax - 1, 1, a.caps, a.cap_bytes + kCapReadSlack);
     m.info.step_count = step + 1;
 }
 

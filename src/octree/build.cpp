@@ -45,7 +45,8 @@ template <typename T> Octree<T> OctreeData<T>::view() const {
         a.node_count[d] = nodes[d].size;
     }
     a.caps = caps.data.get();
-    a.cap_count = caps.size;
+    a.cap_bytes = cap_bytes;
+    a.cap_count = cap_count;
     return Octree<T>(a);
 }
 
@@ -133,50 +134,52 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
         for (auto* p : parts) total += p->nodes[size_t(d)].size();
         // Children at depth d+1, as they will be concatenated (before this depth's moves free them).
         uint64_t next_total = 0;
-        if (d + 1 == dmax - 1) for (auto& s : sinks) next_total += s.caps.size();
+        const bool caps_below = d + 1 == dmax - 1;
+        if (caps_below) for (auto& s : sinks) next_total += s.caps.size();
         else if (d + 1 < k) next_total = top.nodes[size_t(d + 1)].size();
         else for (auto& s : sinks) next_total += s.nodes[size_t(d + 1)].size();
+        // Interior children are 32-bit node indices, caps 48-bit byte offsets (octree.h).
+        const uint64_t limit = caps_below ? kMaxCapByteOffset : uint64_t(1) << 32;
         out.nodes[size_t(d)] = UninitArray<InteriorNode<T>>::make(total);
         uint64_t at = 0, child_offset = 0;
         for (auto* p : parts) {
             auto& v = p->nodes[size_t(d)];
-            if (d >= k) {
-                for (auto& n : v) {
-                    const uint64_t global = uint64_t(n.child_start) + child_offset;
-                    if (global + uint64_t(std::popcount(unsigned(n.child_mask))) > (uint64_t(1) << 32))
-                        throw Error(options.source_name, "octree too large: more than 2^32 nodes at depth " +
-                                                             std::to_string(d + 1) + " (32-bit child indices)");
-                    n.child_start = uint32_t(global);
-                    OCTISO_CHECK(global + uint64_t(std::popcount(unsigned(n.child_mask))) <= next_total,
-                                 "depth ", d, ": children from ", global, " past ", next_total, " at depth ", d + 1);
-                }
-                child_offset += d + 1 == dmax - 1 ? p->caps.size() : p->nodes[size_t(d + 1)].size();
-            } else {
-                for (const auto& n : v)
-                    OCTISO_CHECK(uint64_t(n.child_start) + uint64_t(std::popcount(unsigned(n.child_mask))) <= next_total,
-                                 "depth ", d, ": children from ", n.child_start, " past ", next_total, " at depth ", d + 1);
+            for (auto& n : v) {
+                const uint64_t span = uint64_t(std::popcount(unsigned(n.child_mask))) * (caps_below ? n.cap_bits : 1u);
+                const uint64_t global = n.first_child() + (d >= k ? child_offset : 0);
+                if (global + span > limit)
+                    throw Error(options.source_name, caps_below ? "octree too large: more than 2^48 bytes of caps"
+                                                                : "octree too large: more than 2^32 nodes at depth " +
+                                                                      std::to_string(d + 1) + " (32-bit child indices)");
+                n.set_first_child(global);
+                OCTISO_CHECK(global + span <= next_total, "depth ", d, ": children from ", global, " past ", next_total,
+                             " at depth ", d + 1);
             }
+            if (d >= k) child_offset += caps_below ? p->caps.size() : p->nodes[size_t(d + 1)].size();
             out.stats.scalar_leaves_per_depth[size_t(d)] += p->leaves[size_t(d)];
             move_into(out.nodes[size_t(d)], at, v);
             if (++moved % kPiecesPerRelease == 0) release_free_memory();
         }
         out.stats.nodes_per_depth[size_t(d)] = total;
     }
-    uint64_t n_caps = 0;
-    for (auto& s : sinks) n_caps += s.caps.size();
-    out.caps = UninitArray<Cap<T>>::make(n_caps);
+    uint64_t n_bytes = 0, n_caps = 0;
+    for (auto& s : sinks) n_bytes += s.caps.size(), n_caps += s.cap_count;
+    out.caps = UninitArray<uint8_t>::make(n_bytes + kCapReadSlack);
     uint64_t at = 0;
     for (auto& s : sinks) {
         move_into(out.caps, at, s.caps);
         if (++moved % kPiecesPerRelease == 0) release_free_memory();
     }
+    std::fill_n(out.caps.data.get() + at, kCapReadSlack, uint8_t(0));
     sinks = {};
     release_free_memory();
+    out.cap_bytes = n_bytes;
+    out.cap_count = n_caps;
     out.stats.nodes_per_depth[size_t(dmax - 1)] = n_caps;
 
     for (int d = 0; d <= dmax - 2; ++d) out.stats.interior_bytes += out.nodes[size_t(d)].size * sizeof(InteriorNode<T>);
-    out.stats.minmax_bytes = out.stats.interior_bytes / sizeof(InteriorNode<T>) * 16 * sizeof(T);
-    out.stats.cap_bytes = n_caps * sizeof(Cap<T>);
+    out.stats.minmax_bytes = out.stats.interior_bytes / sizeof(InteriorNode<T>) * sizeof(ChildBounds<T>);
+    out.stats.cap_bytes = n_bytes;
     out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
 }

@@ -35,22 +35,24 @@ public:
             for (uint32_t y = c.y; y < y1; ++y) std::fill(out_ + index(c.x, y, z), out_ + index(x1, y, z), value);
     }
 
-    void fill_cap(Coord c, const Cap<T>& cap) const {
+    void fill_cap(Coord c, const CapRef<T>& cap) const {
+        T v[8];
+        cap.decode(v);
         for (int o = 0; o < 8; ++o) {
             const uint32_t x = c.x + uint32_t(o >> 2), y = c.y + uint32_t((o >> 1) & 1), z = c.z + uint32_t(o & 1);
-            if (x < dims_.x && y < dims_.y && z < dims_.z) out_[index(x, y, z)] = cap.voxel[o];
+            if (x < dims_.x && y < dims_.y && z < dims_.z) out_[index(x, y, z)] = v[o];
         }
     }
 
-    /// Fills the subtree at node `index` of `depth` whose cube starts at `c`.
+    /// Fills the subtree at node `index` of `depth` (<= dmax-2) whose cube starts at `c`.
     void fill_node(int depth, uint32_t index, Coord c) const {
         if (c.x >= dims_.x || c.y >= dims_.y || c.z >= dims_.z) return;
-        if (depth == o_.cap_depth()) return fill_cap(c, o_.cap(index));
         const InteriorNode<T>& n = o_.node(depth, index);
         const uint32_t half = o_.child_bit(depth);
         for (int ch = 0; ch < 8; ++ch) {
             const Coord cc = child_corner(c, ch, half);
             if (n.is_scalar_leaf(ch)) fill_block(cc, half, n.scalar[ch]);
+            else if (depth + 1 == o_.cap_depth()) fill_cap(cc, o_.cap(n, ch));
             else fill_node(depth + 1, n.child_index(ch), cc);
         }
     }
@@ -82,7 +84,7 @@ template <typename T> void decode_to_dense(const Octree<T>& octree, T* out) {
     constexpr size_t kPieces = 512;
     const Dims dims = octree.dims();
     std::vector<Piece<T>> pieces{{0, 0, T{}, Coord{}, octree.side()}};
-    for (int d = 0; d < octree.cap_depth() && pieces.size() < kPieces; ++d) {
+    for (int d = 0; d + 1 < octree.cap_depth() && pieces.size() < kPieces; ++d) {   // pieces stop at the cap parents
         std::vector<Piece<T>> next;
         for (const Piece<T>& p : pieces) {
             if (p.depth != d) {

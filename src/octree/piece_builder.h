@@ -17,10 +17,12 @@
 
 namespace octiso::detail {
 
-/// One piece's output: node records by absolute depth, caps, leaf counts by depth.
+/// One piece's output: node records by absolute depth, packed caps (bytes) and their count, leaf
+/// counts by depth.
 template <typename T> struct Sink {
     std::vector<std::vector<InteriorNode<T>>> nodes;
-    std::vector<Cap<T>> caps;
+    std::vector<uint8_t> caps;
+    uint64_t cap_count = 0;
     std::vector<uint64_t> leaves;
     explicit Sink(int dmax) : nodes(size_t(dmax)), leaves(size_t(dmax), 0) {}
 };
@@ -74,12 +76,18 @@ public:
     }
 
     /// Folds 8 child summaries into a leaf, or stores an interior node at depth d.
-    /// `start` is the index the first stored child got at depth d+1 (local to the sink).
-    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, Sink<T>& sink) const {
+    /// `start` is the index the first stored child got at depth d+1 (local to the sink; for a cap
+    /// parent the byte offset of its first cap), `caps` a cap parent's `n_caps` caps in order.
+    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, Sink<T>& sink, const Cap<T>* caps = nullptr,
+                       int n_caps = 0) const {
         Summary<T> out;
         InteriorNode<T> n;
         auto merge = [this](T lo, T hi, T& rep) { return mergeable(lo, hi, rep); };
         if (fold_children(d, ch, start, merge, out, n)) return out;
+        if (n_caps) {
+            append_caps(n, caps, n_caps, sink.caps);
+            sink.cap_count += uint64_t(n_caps);
+        }
         sink.nodes[size_t(d)].push_back(n);
         sink.leaves[size_t(d)] += uint64_t(8 - std::popcount(unsigned(n.child_mask)));
         return out;
@@ -93,11 +101,13 @@ public:
 
         // 2. Each block: a scalar leaf or a cap (summary.h).
         Summary<T> ch[8];
+        Cap<T> caps[8];
+        int n_caps = 0;
         const uint64_t start = sink.caps.size();
         cap_parent_children(
             L, o, dims_, [this](T lo, T hi, T& rep) { return mergeable(lo, hi, rep); },
-            [this](T& lo, T& hi) { widen(lo, hi); }, [&](const Cap<T>& cap) { sink.caps.push_back(cap); }, ch);
-        return combine(dmax_ - 2, ch, start, sink);
+            [this](T& lo, T& hi) { widen(lo, hi); }, [&](const Cap<T>& cap) { caps[n_caps++] = cap; }, ch);
+        return combine(dmax_ - 2, ch, start, sink, caps, n_caps);
     }
 
     const VolumeView<T> v_;

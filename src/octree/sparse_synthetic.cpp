@@ -97,10 +97,13 @@ public:
         // Every stored node's children must lie in the next depth's array (the loader would refuse
         // the file; an in-memory octree would be traversed out of bounds).
         for (int d = 0; d <= dmax_ - 2; ++d) {
-            const uint64_t next = d + 1 == dmax_ - 1 ? caps_.size() : nodes_[size_t(d + 1)].size();
-            for (const InteriorNode<T>& n : nodes_[size_t(d)])
-                OCTISO_CHECK(uint64_t(n.child_start) + uint64_t(std::popcount(unsigned(n.child_mask))) <= next,
-                             "depth ", d, ": children from ", n.child_start, " past ", next, " at depth ", d + 1);
+            const bool caps_below = d + 1 == dmax_ - 1;
+            const uint64_t next = caps_below ? caps_.size() : nodes_[size_t(d + 1)].size();
+            for (const InteriorNode<T>& n : nodes_[size_t(d)]) {
+                const uint64_t span = uint64_t(std::popcount(unsigned(n.child_mask))) * (caps_below ? n.cap_bits : 1u);
+                OCTISO_CHECK(n.first_child() + span <= next, "depth ", d, ": children from ", n.first_child(), " past ",
+                             next, " at depth ", d + 1);
+            }
         }
         OctreeData<T> out;
         out.dims = dims_;
@@ -115,11 +118,14 @@ public:
             out.stats.nodes_per_depth[size_t(d)] = v.size();
             out.stats.interior_bytes += v.size() * sizeof(InteriorNode<T>);
         }
-        out.caps = UninitArray<Cap<T>>::make(caps_.size());
+        out.caps = UninitArray<uint8_t>::make(caps_.size() + kCapReadSlack);
         std::copy(caps_.begin(), caps_.end(), out.caps.data.get());
-        out.stats.nodes_per_depth[size_t(dmax_ - 1)] = caps_.size();
-        out.stats.minmax_bytes = out.stats.interior_bytes / sizeof(InteriorNode<T>) * 16 * sizeof(T);
-        out.stats.cap_bytes = caps_.size() * sizeof(Cap<T>);
+        std::fill_n(out.caps.data.get() + caps_.size(), kCapReadSlack, uint8_t(0));
+        out.cap_count = cap_count_;
+        out.cap_bytes = caps_.size();
+        out.stats.nodes_per_depth[size_t(dmax_ - 1)] = cap_count_;
+        out.stats.minmax_bytes = out.stats.interior_bytes / sizeof(InteriorNode<T>) * sizeof(ChildBounds<T>);
+        out.stats.cap_bytes = caps_.size();
         return out;
     }
 
@@ -198,12 +204,16 @@ private:
 
     // The same rules as build_octree with tolerance 0 (summary.h); the tests compare the arrays
     // node for node.
-    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start) {
-        if (start > std::numeric_limits<uint32_t>::max())
+    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, const Cap<T>* caps = nullptr, int n_caps = 0) {
+        if (start > (d + 1 == dmax_ - 1 ? kMaxCapByteOffset : uint64_t(std::numeric_limits<uint32_t>::max())))
             throw Error("sparse-spheres", "octree too large: more than 2^32 nodes at depth " + std::to_string(d + 1));
         Summary<T> out;
         InteriorNode<T> n;
         if (detail::fold_children(d, ch, start, &SparseBuilder::mergeable, out, n)) return out;
+        if (n_caps) {
+            detail::append_caps(n, caps, n_caps, caps_);
+            cap_count_ += uint64_t(n_caps);
+        }
         nodes_[size_t(d)].push_back(n);
         leaves_[size_t(d)] += uint64_t(8 - std::popcount(unsigned(n.child_mask)));
         return out;
@@ -213,10 +223,12 @@ private:
         T L[5][5][5];
         detail::load_neighbourhood(o, dims_, [this](uint32_t x, uint32_t y, uint32_t z) { return f_.value<T>(x, y, z); }, L);
         Summary<T> ch[8];
+        Cap<T> caps[8];
+        int n_caps = 0;
         const uint64_t start = caps_.size();
         detail::cap_parent_children(
-            L, o, dims_, &SparseBuilder::mergeable, [](T&, T&) {}, [&](const Cap<T>& cap) { caps_.push_back(cap); }, ch);
-        return combine(dmax_ - 2, ch, start);
+            L, o, dims_, &SparseBuilder::mergeable, [](T&, T&) {}, [&](const Cap<T>& cap) { caps[n_caps++] = cap; }, ch);
+        return combine(dmax_ - 2, ch, start, caps, n_caps);
     }
 
     const SparseSpheres& f_;
@@ -225,7 +237,8 @@ private:
     T background_{};
     std::vector<Box> supports_;
     std::vector<std::vector<InteriorNode<T>>> nodes_;   // by depth, DFS post-order
-    std::vector<Cap<T>> caps_;
+    std::vector<uint8_t> caps_;   // packed cap records
+    uint64_t cap_count_ = 0;
     std::vector<uint64_t> leaves_;
 };
 

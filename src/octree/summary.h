@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <bit>
 #include <limits>
+#include <vector>
 
 #include "octiso/octree.h"
+#include "octree/pack.h"
 #include "util/check.h"
 
 namespace octiso::detail {
@@ -35,8 +37,9 @@ inline Coord child_origin(Coord o, int c, uint32_t half) {
 
 /// Folds the 8 child summaries of a node at depth d. Returns true with `out` = the merged scalar
 /// leaf when all children are leaves whose data ranges `mergeable(lo, hi, rep)` accepts (never at
-/// d == 0: the root is always stored). Otherwise fills `node` (child_start = `start`, local to the
-/// caller's arrays) and `out` with the stored node's summary, and returns false.
+/// d == 0: the root is always stored). Otherwise fills `node` (first child `start`, local to the
+/// caller's arrays; bounds packed, pack.h; a cap parent's caps are packed by pack_caps after) and
+/// `out` with the stored node's summary, and returns false.
 template <typename T, class Mergeable>
 bool fold_children(int d, const Summary<T>* ch, uint64_t start, const Mergeable& mergeable, Summary<T>& out,
                    InteriorNode<T>& node) {
@@ -68,16 +71,26 @@ bool fold_children(int d, const Summary<T>* ch, uint64_t start, const Mergeable&
     }
     node = InteriorNode<T>{};
     uint8_t mask = 0;
+    T mn[8], mx[8];
     for (int c = 0; c < 8; ++c) {
         node.scalar[c] = ch[c].scalar;
-        node.min[c] = ch[c].cell_min;
-        node.max[c] = ch[c].cell_max;
+        mn[c] = ch[c].cell_min;
+        mx[c] = ch[c].cell_max;
         if (!ch[c].is_leaf) mask = uint8_t(mask | (1u << c));
     }
     node.child_mask = mask;
-    node.child_start = uint32_t(start);   // local; the caller offsets and range-checks it
+    node.bounds = pack_bounds(mn, mx);
+    node.set_first_child(start);   // local; the caller offsets and range-checks it
     out = {any_data ? midpoint(lo, hi) : T{}, cmin, cmax, lo, hi, false, !any_data};
     return false;
+}
+
+/// A cap parent just stored: packs its `n` caps (its stored children in order, pack.h) into the
+/// node and appends their records to `bytes`, the caller's cap level.
+template <typename T> void append_caps(InteriorNode<T>& node, const Cap<T>* caps, int n, std::vector<uint8_t>& bytes) {
+    uint8_t buf[8 * sizeof(Cap<T>) + kCapReadSlack];
+    const uint64_t written = pack_caps(node, caps, n, buf);
+    bytes.insert(bytes.end(), buf, buf + written);
 }
 
 /// The 5^3 voxel neighbourhood L[z][y][x] = voxel(o + (x, y, z)) of a node at depth dmax-2 with

@@ -84,12 +84,11 @@ template <typename T> struct OctreeCorners {
     Octree<T> tree;
     void gather(Coord v, double corner[8]) const {
         uint32_t trace[kMaxDepth];
-        const int cap_depth = tree.dmax() - 1;
+        const int cap_parents = tree.dmax() - 2;
         int d = 0;
         uint32_t index = 0;
         for (;;) {
             trace[d] = index;
-            if (d == cap_depth) break;
             const InteriorNode<T>& n = tree.node(d, index);
             const int c = octant_of(v, tree.child_bit(d));
             if (n.is_scalar_leaf(c)) {
@@ -104,19 +103,22 @@ template <typename T> struct OctreeCorners {
                 }
                 return;
             }
+            if (d == cap_parents) {
+                const CapRef<T> cap = tree.cap(n, c);
+                const int oct = octant_of(v, 1u);
+                for (int k = 0; k < 8; ++k) {
+                    const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
+                    if ((oct & dir) == 0) {
+                        corner[k] = double(cap.voxel(oct | dir));
+                    } else {
+                        const Coord dest{v.x + (k & 1), v.y + ((k >> 1) & 1), v.z + ((k >> 2) & 1)};
+                        corner[k] = double(tree.neighbour_find(v, dest, cap_parents, trace));
+                    }
+                }
+                return;
+            }
             index = n.child_index(c);
             ++d;
-        }
-        const Cap<T>& cap = tree.cap(index);
-        const int oct = octant_of(v, 1u);
-        for (int k = 0; k < 8; ++k) {
-            const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
-            if ((oct & dir) == 0) {
-                corner[k] = double(cap.voxel[oct | dir]);
-            } else {
-                const Coord dest{v.x + (k & 1), v.y + ((k >> 1) & 1), v.z + ((k >> 2) & 1)};
-                corner[k] = double(tree.neighbour_find(v, dest, cap_depth, trace));
-            }
         }
     }
 };

@@ -39,8 +39,9 @@ struct PixelTraceRecorder {
     void scalar_leaf(int d, const Coord& o, uint32_t side, double value, double t0, double t1, bool all_cells) const {
         push({Kind::scalar_leaf, d, 0, o, side, t0, t1, value, value, all_cells});
     }
-    void enter_cap(int d, uint32_t index, const Coord& o, double t0, double t1) const {
-        push({Kind::cap, d, index, o, 2, t0, t1});
+    /// `parent`: the index of the cap's parent at depth dmax-2 (caps are byte offsets, octree.h).
+    void enter_cap(int d, uint32_t parent, const Coord& o, double t0, double t1) const {
+        push({Kind::cap, d, parent, o, 2, t0, t1});
     }
     void cell(const Coord& v, double t_in, double t_out, bool closed_end, double lo, double hi) const {
         push({Kind::cell, -1, 0, v, 1, t_in, t_out, lo, hi, closed_end});
@@ -92,7 +93,7 @@ std::string PixelTrace::text() const {
                 break;
             case Kind::cap:
                 level = e.depth, inner = e.depth + 1;
-                line = format("cap #%u origin %s t [%.17g, %.17g)", e.index, coord_text(e.origin).c_str(), e.t0, e.t1);
+                line = format("cap under node #%u origin %s t [%.17g, %.17g)", e.index, coord_text(e.origin).c_str(), e.t0, e.t1);
                 break;
             case Kind::cell:
                 line = format("cell %s t [%.17g, %.17g%s corners [%.9g, %.9g]", coord_text(e.origin).c_str(), e.t0, e.t1,

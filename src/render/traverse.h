@@ -187,15 +187,15 @@ private:
         for_each_child_piece(w.ray, o, half, t0, t1, [&](int c, double t_cur, double t_next) {
             if constexpr (Recorder::kOn)
                 if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count))
-                    recorder_.cull(d, c, child_origin_of(o, c, half), half, double(n.min[c]), double(n.max[c]), t_cur,
-                                   t_next);
+                    recorder_.cull(d, c, child_origin_of(o, c, half), half, n.bounds.lower(c), n.bounds.upper(c),
+                                   t_cur, t_next);
             if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) return false;
             const Coord co = child_origin_of(o, c, half);
             if (restricted_ && !overlaps_owned(co, half)) return false;
             if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
             else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;
-                hit = cap(w, w.trace, n.child_index(c), co, t_cur, t_next, blocks);
+                hit = cap(w, w.trace, tree_.cap(n, c), co, t_cur, t_next, blocks);
             } else hit = node(w, d + 1, n.child_index(c), co, t_cur, t_next);
             return hit;
         });
@@ -236,12 +236,15 @@ private:
         return false;
     }
 
-    /// The forward neighbour blocks of one cap (2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), r = 1..7):
-    /// each is a cap or lies inside one scalar leaf, located by neighbour finding on first use and
-    /// then read directly. One per cap visit; a packet shares it between its lanes.
+    /// The cap (block 0) and its forward neighbour blocks (2x2x2 at co + 2 * (r>>2&1, r>>1&1,
+    /// r&1), r = 1..7): each neighbour is a cap or lies inside one scalar leaf, located by
+    /// neighbour finding on first use and then read directly. One per cap visit; a packet shares
+    /// it between its lanes.
     struct CapBlocks {
-        LeafRef<T> block[8];
-        unsigned located = 0;
+        CapRef<T> cap[8];     ///< blocks in a cap: read voxel by voxel (a whole decode cost 8-29 %)
+        T value[8];           ///< blocks inside a scalar leaf
+        unsigned located = 1;   ///< block 0 is the cap itself
+        unsigned in_cap = 1;
     };
 
     /// One packet of rays sharing their direction signs: per lane its walk, its piece [t0, t1) of
@@ -295,7 +298,7 @@ private:
                 }
             } else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;   // located once for every lane that crosses this cap
-                const uint32_t ci = n.child_index(int(c));
+                const CapRef<T> ci = tree_.cap(n, int(c));
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
                     if (cap(p.lane[k], p.trace, ci, co, c0[c][k], c1[c][k], blocks)) hit |= 1u << k;
@@ -315,14 +318,13 @@ private:
         return active;
     }
 
-    bool cap(RayState& w, uint32_t* trace, uint32_t cap_index, const Coord& co, double t0, double t1,
+    bool cap(RayState& w, const uint32_t* trace, const CapRef<T>& ref, const Coord& co, double t0, double t1,
              CapBlocks& blocks) const {
-        OCTISO_DCHECK(cap_index < tree_.cap_count(), "cap ", cap_index, " of ", tree_.cap_count());
-        if constexpr (Recorder::kOn) recorder_.enter_cap(tree_.dmax() - 1, cap_index, co, t0, t1);
-        trace[tree_.dmax() - 1] = cap_index;
-        const Cap<T>& cap = tree_.cap(cap_index);
-        LeafRef<T>* block = blocks.block;
+        const int parent_depth = tree_.dmax() - 2;
+        if constexpr (Recorder::kOn) recorder_.enter_cap(parent_depth + 1, trace[parent_depth], co, t0, t1);
         unsigned& located = blocks.located;
+        unsigned& in_cap = blocks.in_cap;
+        blocks.cap[0] = ref;
         // Sort-last (set_owned_cells): decided once per cap.
         const bool cap_on_ghost = restricted_ && ghost_ && co.x + 2 == owned_.hi[0];
         return walk_cells(w, co, 2, t0, t1, restricted_ && !inside_owned(co, 2), [&](Coord v, double corner[8]) {
@@ -339,17 +341,16 @@ private:
                 }
                 const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
                 const int r = oct & dir;                                         // which block holds the corner
-                if (r == 0) {
-                    corner[k] = double(cap.voxel[oct | dir]);
-                    continue;
-                }
                 if (!((located >> r) & 1u)) {
+                    // Outside this cap, so the climb starts at its parent (octree.h).
                     const Coord b{co.x + ((r & 4) ? 2u : 0u), co.y + ((r & 2) ? 2u : 0u), co.z + ((r & 1) ? 2u : 0u)};
-                    block[r] = tree_.neighbour_locate(co, b, tree_.dmax() - 1, trace);
+                    const LeafRef<T> found = tree_.neighbour_locate(co, b, parent_depth, trace);
+                    if (found.in_cap) blocks.cap[r] = found.cap;
+                    else blocks.value[r] = found.value;
+                    in_cap |= unsigned(found.in_cap) << r;
                     located |= 1u << r;
                 }
-                corner[k] = block[r].in_cap ? double(tree_.cap(block[r].index).voxel[(oct | dir) & ~r])
-                                            : double(block[r].value);
+                corner[k] = ((in_cap >> r) & 1u) ? double(blocks.cap[r].voxel((oct | dir) & ~r)) : double(blocks.value[r]);
             }
         });
     }

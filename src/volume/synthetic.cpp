@@ -244,9 +244,46 @@ struct Mixing {
     }
 };
 
+// A CT-like head in Hounsfield units (issue 19's noisy i16 test volume, like the paper's CThead):
+// air (-1000) around an ellipsoidal head of soft tissue (40) over a skull of dense bone
+// (1100-1700, porous inside) around a brain (grey/white 30-45) with two CSF ventricles (5).
+// Borders blur over about a voxel (partial volume) and every voxel carries scanner noise of
+// about 12 HU (a sum of three hashed uniforms), so, as in a real scan, almost nothing merges.
+struct CtHead {
+    double c[3], inv[3];   // centre and 1 / semi-axes, in voxels
+    double vox;            // voxels per unit of the normalised radius (for the blur)
+    explicit CtHead(Dims d) {
+        const double n[3] = {double(d.x), double(d.y), double(d.z)};
+        const double semi[3] = {0.40 * n[0], 0.46 * n[1], 0.42 * n[2]};
+        for (int a = 0; a < 3; ++a) c[a] = 0.5 * (n[a] - 1), inv[a] = 1.0 / semi[a];
+        vox = std::min({semi[0], semi[1], semi[2]});
+    }
+    double operator()(uint32_t x, uint32_t y, uint32_t z) const {
+        const double p[3] = {(x - c[0]) * inv[0], (y - c[1]) * inv[1], (z - c[2]) * inv[2]};
+        const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        const double w = 1.0 / vox;   // one voxel in normalised radius
+        auto inside = [&](double edge) { return smoothstep(edge + w, edge - w, r); };
+        const double porous = fbm(x * 0.08, y * 0.08, z * 0.08, 3, 0x626f6e65ull);
+        const double bone = 1100 + 600 * porous;
+        const double grey = fbm(x * 0.03, y * 0.03, z * 0.03, 3, 0x627261696eull);
+        double brain = 30 + 15 * grey;
+        for (double side : {-0.18, 0.18}) {   // ventricles: small ellipsoids beside the midline
+            const double q[3] = {(p[0] - side) / 0.12, p[1] / 0.30, (p[2] - 0.05) / 0.15};
+            const double rv = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+            brain += (5 - brain) * smoothstep(1 + 3 * w, 1 - 3 * w, rv);
+        }
+        double v = -1000;
+        v += (40 - v) * inside(1.0);      // skin and soft tissue
+        v += (bone - v) * inside(0.93);   // skull
+        v += (brain - v) * inside(0.86);  // brain
+        const double noise = unit(hash3(x, y, z, 0x6374a)) + unit(hash3(x, y, z, 0x6374b)) + unit(hash3(x, y, z, 0x6374c));
+        return v + 24.0 * (noise - 1.5);   // sigma = 24 / 2 = 12 HU
+    }
+};
+
 // ---- names, conversion, parallel fill ------------------------------------------------------
 
-enum class Gen { sphere, marschner_lobb, sponge, noise, plume, mixing, plume_series };
+enum class Gen { sphere, marschner_lobb, sponge, noise, plume, mixing, plume_series, ct_head };
 
 struct GenInfo {
     Gen gen;
@@ -263,6 +300,7 @@ constexpr GenInfo kGens[] = {
     {Gen::plume, "plume", ScalarType::u8, 1.0},
     {Gen::mixing, "mixing", ScalarType::u8, 1.0},
     {Gen::plume_series, "plume-series", ScalarType::u8, 1.0},
+    {Gen::ct_head, "ct-head", ScalarType::i16, 1.0},
 };
 
 const GenInfo* find_gen(std::string_view name) {
@@ -368,6 +406,7 @@ template <typename T> std::vector<T> generate_synthetic(std::string_view name, D
         case Gen::plume:
         case Gen::plume_series: fill(out, dims, Plume(dims, k), g.int_scale); break;
         case Gen::mixing: fill(out, dims, Mixing(dims), g.int_scale); break;
+        case Gen::ct_head: fill(out, dims, CtHead(dims), g.int_scale); break;
     }
     return out;
 }

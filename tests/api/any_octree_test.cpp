@@ -62,8 +62,9 @@ template <typename T> void expect_same_arrays(const Octree<T>& a, const Octree<T
         }
     }
     ASSERT_EQ(a.cap_count(), b.cap_count());
-    if (a.cap_count() != 0) {
-        EXPECT_EQ(0, std::memcmp(&a.cap(0), &b.cap(0), a.cap_count() * sizeof(Cap<T>)));
+    ASSERT_EQ(a.cap_bytes(), b.cap_bytes());
+    if (a.cap_bytes() != 0) {
+        EXPECT_EQ(0, std::memcmp(a.arrays().caps, b.arrays().caps, a.cap_bytes()));
     }
 }
 

@@ -26,8 +26,9 @@ template <typename T> void expect_same_arrays(const Octree<T>& a, const Octree<T
         }
     }
     ASSERT_EQ(a.cap_count(), b.cap_count());
-    if (a.cap_count() != 0) {
-        EXPECT_EQ(0, std::memcmp(&a.cap(0), &b.cap(0), a.cap_count() * sizeof(Cap<T>)));
+    ASSERT_EQ(a.cap_bytes(), b.cap_bytes());
+    if (a.cap_bytes() != 0) {
+        EXPECT_EQ(0, std::memcmp(a.arrays().caps, b.arrays().caps, a.cap_bytes()));
     }
 }
 
@@ -226,16 +227,18 @@ TEST(DecodeToDense, HandMadeTreeMatchesPointLocationOnEveryVoxel) {
     InteriorNode<int16_t> root{};
     root.child_mask = 0b00100001;
     root.child_start = 0;
+    root.cap_bits = 16;   // caps stored whole (octree.h): 8 int16 voxels each, then the read slack
     for (int c = 0; c < 8; ++c) root.scalar[c] = int16_t(-100 * c - 1);
-    std::vector<Cap<int16_t>> caps(2);
+    std::vector<int16_t> caps(2 * 8 + kCapReadSlack / sizeof(int16_t), 0);
     for (int i = 0; i < 2; ++i)
-        for (int o = 0; o < 8; ++o) caps[size_t(i)].voxel[o] = int16_t(10 * i + o);
+        for (int o = 0; o < 8; ++o) caps[size_t(8 * i + o)] = int16_t(10 * i + o);
     OctreeArrays<int16_t> a;
     a.dims = dims;
     a.dmax = 2;
     a.nodes[0] = &root;
     a.node_count[0] = 1;
-    a.caps = caps.data();
+    a.caps = reinterpret_cast<const uint8_t*>(caps.data());
+    a.cap_bytes = 2 * 16;
     a.cap_count = 2;
     const Octree<int16_t> tree(a);
 

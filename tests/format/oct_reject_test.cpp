@@ -183,12 +183,78 @@ TEST(OctReject, ChildIndicesOutOfRangeOrOverlappingAreErrors) {
             n.child_mask = uint8_t(n.child_mask & (n.child_mask - 1));   // one child bit fewer
             b.set_node(0, d, i, n);
         }, "child_mask with too few bits (a node below loses its parent)");
-        fx.expect_rejected([&](OctBytes& b) {
-            auto n = b.node<uint8_t>(0, d, 0);
-            n.reserved[1] = 1;
-            b.set_node(0, d, 0, n);
-        }, "reserved byte set");
+        if (d < dmax - 2) {
+            fx.expect_rejected([&](OctBytes& b) {
+                auto n = b.node<uint8_t>(0, d, 0);
+                n.cap_bits = 1;
+                b.set_node(0, d, 0, n);
+            }, "cap_bits above the cap parents");
+            fx.expect_rejected([&](OctBytes& b) {
+                auto n = b.node<uint8_t>(0, d, 0);
+                n.child_start_hi = 1;
+                b.set_node(0, d, 0, n);
+            }, "48-bit offset above the cap parents");
+        } else {
+            fx.expect_rejected([&](OctBytes& b) {
+                const uint64_t i = last_parent(b, d);
+                auto n = b.node<uint8_t>(0, d, i);
+                n.cap_bits = uint8_t(n.cap_bits + 1);   // its caps now run past the level
+                b.set_node(0, d, i, n);
+            }, "cap_bits one too large");
+            fx.expect_rejected([&](OctBytes& b) {
+                auto n = b.node<uint8_t>(0, d, last_parent(b, d));
+                n.child_start_hi = 1;   // 2^32 bytes on
+                b.set_node(0, d, last_parent(b, d), n);
+            }, "cap offset past the level in its high bits");
+        }
     }
+}
+
+/// Format 3's own fields (issue 19), on a u16 file (quantized bounds, caps up to 16 bits):
+/// each check names what it found.
+TEST(OctReject, CompactNodeFieldsAreValidated) {
+    ScratchDir dir;
+    const std::string good = dir.file("good.oct"), bad = dir.file("bad.oct");
+    const auto v = make_volume<uint16_t>({9, 6, 5}, Pattern::Random, 3);
+    write_oct<uint16_t>(good, info_for(ScalarType::u16, v.dims), {build_octree(v.view(), {}).view()});
+    const int dmax = OctBytes(good).header().dmax;
+    auto expect = [&](const std::function<void(OctBytes&)>& edit, const std::string& words) {
+        OctBytes b(good);
+        edit(b);
+        b.rechecksum();
+        b.save(bad);
+        for (Verify verify : {Verify::Full, Verify::IndicesOnly}) {
+            try {
+                load_everything(bad, verify);
+                ADD_FAILURE() << words << ": accepted";
+            } catch (const Error& e) {
+                EXPECT_EQ(e.subject(), bad);
+                EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+            }
+        }
+    };
+    expect([&](OctBytes& b) {
+        auto n = b.node<uint16_t>(0, dmax - 2, 0);
+        n.cap_bits = 17;   // neither a packed width (<= 15) nor whole (16)
+        b.set_node(0, dmax - 2, 0, n);
+    }, "cap_bits out of range (expected 0 .. 15 or 16, found 17)");
+    expect([&](OctBytes& b) {
+        auto n = b.node<uint16_t>(0, 0, 0);
+        std::swap(n.bounds.lo, n.bounds.hi);
+        if (n.bounds.lo == n.bounds.hi) n.bounds.lo = uint16_t(n.bounds.hi + 1);
+        b.set_node(0, 0, 0, n);
+    }, "bounds range is not finite and ordered");
+    expect([&](OctBytes& b) {
+        const SectionEntry s = b.entry(b.entry_index(0, dmax - 1));
+        b.bytes[s.offset + s.bytes - 1] = 1;   // the read slack after the last cap
+    }, "bytes after the last cap are not zero");
+    expect([&](OctBytes& b) {
+        // A cap level shorter than its read slack: the table says 7 bytes.
+        const uint64_t i = b.entry_index(0, dmax - 1);
+        SectionEntry s = b.entry(i);
+        s.count = s.bytes = 7;
+        b.set_entry(i, s);
+    }, "the cap level must end with 8 zero bytes");
 }
 
 TEST(OctReject, MessagesNameFileStepDepthNodeAndNumbers) {
@@ -288,8 +354,10 @@ TEST(OctReject, HostileSectionTablesAreErrors) {
         }, "bytes that wrap");
         fx.expect_rejected([&](OctBytes& b) {
             SectionEntry s = b.entry(i);
-            // count * record wraps around to the real byte size.
-            s.count = s.count + (uint64_t(1) << 63) / (s.record_bytes & -s.record_bytes) * 2;
+            // count * record wraps around to the real byte size. The cap level is a byte array
+            // (record size 1, format 3): nothing wraps there, so a count far past its bytes.
+            if (s.record_bytes == 1) s.count += uint64_t(1) << 63;
+            else s.count = s.count + (uint64_t(1) << 63) / (s.record_bytes & -s.record_bytes) * 2;
             b.set_entry(i, s);
         }, "count * record size that wraps");
         fx.expect_rejected([&](OctBytes& b) {
@@ -399,6 +467,31 @@ TEST(OctReject, VersionOneFilesAskToBeConvertedAgain) {
         ADD_FAILURE() << "a version 1 file was opened";
     } catch (const Error& e) {
         EXPECT_EQ(e.exit_status(), 2);
+        EXPECT_NE(std::string(e.what()).find("convert the source again with octiso-convert"), std::string::npos) << e.what();
+    }
+}
+
+TEST(OctReject, VersionTwoFilesAskToBeConvertedAgain) {
+    // Version 2 stored wide nodes and whole caps: nothing in it reads as format 3.
+    ScratchDir dir;
+    const std::string path = dir.file("v2.oct");
+    {
+        const std::vector<uint8_t> v(4 * 4 * 4, 7);
+        AnyOctree::build(VolumeView<uint8_t>{reinterpret_cast<const std::byte*>(v.data()), Dims{4, 4, 4}, false}, Placement{}, {})
+            .save(path);
+    }
+    OctBytes b(path);
+    FileHeader h = b.header();
+    h.version = 2;
+    b.set_header(h);
+    b.rechecksum();
+    b.save(path);
+    try {
+        OctFile::open(path);
+        ADD_FAILURE() << "a version 2 file was opened";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.exit_status(), 2);
+        EXPECT_NE(std::string(e.what()).find("format version 2"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("convert the source again with octiso-convert"), std::string::npos) << e.what();
     }
 }

@@ -46,7 +46,7 @@ TEST(HostileVerify, InvertedRangesInEveryNodeAreReported) {
     for (int d = 0; d + 1 < dmax; ++d)
         for (uint64_t i = 0; i < b.entry(b.entry_index(0, d)).count; ++i) {
             InteriorNode<uint8_t> n = b.node<uint8_t>(0, d, i);
-            for (int c = 0; c < 8; ++c) n.min[c] = 255, n.max[c] = 0;
+            for (int c = 0; c < 8; ++c) n.bounds.min[c] = 255, n.bounds.max[c] = 0;
             b.set_node(0, d, i, n);
         }
     b.rechecksum();
@@ -73,24 +73,28 @@ TEST(HostileVerify, OneNarrowedRangeOrMisplacedScalarIsReported) {
     ASSERT_EQ(run_shell("'" + kTools + "/octiso-convert' --synthetic noise:32 --type u8 -o '" + good + "' 2>/dev/null"), 0);
     const OctBytes original(good);
     const int d = original.header().dmax - 2;   // the deepest interior level
+    const int above = d - 1;                    // its children are nodes: their scalar is a midpoint
     bool narrowed = false, moved = false;
-    for (uint64_t i = 0; i < original.entry(original.entry_index(0, d)).count && !(narrowed && moved); ++i)
+    for (uint64_t i = 0; i < original.entry(original.entry_index(0, d)).count && !narrowed; ++i)
         for (int c = 0; c < 8; ++c) {
             InteriorNode<uint8_t> n = original.node<uint8_t>(0, d, i);
-            if (!narrowed && n.min[c] < n.max[c]) {
+            if (!narrowed && n.bounds.min[c] < n.bounds.max[c]) {
                 OctBytes b = original;
-                ++n.min[c];
+                ++n.bounds.min[c];
                 b.set_node(0, d, i, n);
                 b.rechecksum();
                 b.save(dir.file("narrow.oct"));
                 EXPECT_THROW(verify_octree(OctFile::open(dir.file("narrow.oct"))), Error);
                 narrowed = true;
             }
-            n = original.node<uint8_t>(0, d, i);
-            if (!moved && !n.is_scalar_leaf(c) && n.max[c] < 255) {
+        }
+    for (uint64_t i = 0; i < original.entry(original.entry_index(0, above)).count && !moved; ++i)
+        for (int c = 0; c < 8; ++c) {
+            InteriorNode<uint8_t> n = original.node<uint8_t>(0, above, i);
+            if (!moved && !n.is_scalar_leaf(c) && n.bounds.max[c] < 255) {
                 OctBytes b = original;
-                n.scalar[c] = uint8_t(n.max[c] + 1);
-                b.set_node(0, d, i, n);
+                n.scalar[c] = uint8_t(n.bounds.max[c] + 1);
+                b.set_node(0, above, i, n);
                 b.rechecksum();
                 b.save(dir.file("scalar.oct"));
                 EXPECT_THROW(verify_octree(OctFile::open(dir.file("scalar.oct"))), Error);

@@ -48,7 +48,25 @@ TEST(Synthetic, ParsesNamesAndSizes) {
     for (const char* bad : {"sphere", "sphere:", "sphere:0", "sphere:4,4", "sphere:4,4,4,4", "teapot:8", "sphere:x",
                             "plume-series:8", "sphere:2000000000"})
         EXPECT_THROW(parse_synthetic(bad), Error) << bad;
-    EXPECT_EQ(synthetic_names().size(), 7u);
+    EXPECT_EQ(synthetic_names().size(), 8u);
+}
+
+TEST(Synthetic, CtHeadHasAirTissueBoneAndNoise) {
+    const Dims d{64, 64, 32};
+    EXPECT_EQ(synthetic_default_type("ct-head"), ScalarType::i16);
+    const std::vector<int16_t> v = generate_synthetic<int16_t>("ct-head", d);
+    EXPECT_EQ(v, generate_synthetic<int16_t>("ct-head", d)) << "deterministic";
+    auto at = [&](uint32_t x, uint32_t y, uint32_t z) { return double(v[x + d.x * (y + uint64_t(d.y) * z)]); };
+    EXPECT_NEAR(at(0, 0, 0), -1000, 18.01) << "air, noise within +-18 HU";
+    EXPECT_NEAR(at(32, 32, 16), 37.5, 26) << "brain";
+    // Along +x from the centre: brain, then the skull (dense bone), then skin, then air.
+    double peak = -2000;
+    for (uint32_t x = 32; x < 64; ++x) peak = std::max(peak, at(x, 32, 16));
+    EXPECT_GT(peak, 700) << "bone (the shell is under 2 voxels thick at this size, so partial volume lowers it)";
+    // Noise: neighbours in the air differ (a real scan never merges).
+    int differ = 0;
+    for (uint32_t x = 0; x + 1 < 8; ++x) differ += at(x, 0, 0) != at(x + 1, 0, 0);
+    EXPECT_GE(differ, 5);
 }
 
 TEST(Synthetic, SphereIsTheDistanceFromTheCentre) {

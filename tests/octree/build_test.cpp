@@ -59,12 +59,11 @@ TYPED_TEST(OctreeBuild, NeighbourFindingEqualsDirectLookup) {
                         const Coord start{x, y, z};
                         int d = 0;
                         uint32_t index = 0;
-                        for (;;) {
+                        for (;;) {   // down to the holding leaf's node, or a cap's parent (octree.h)
                             trace[d] = index;
-                            if (d == tree.cap_depth()) break;
                             const auto& n = tree.node(d, index);
                             const int c = octant_of(start, tree.child_bit(d));
-                            if (n.is_scalar_leaf(c)) break;
+                            if (n.is_scalar_leaf(c) || d + 1 == tree.cap_depth()) break;
                             index = n.child_index(c);
                             ++d;
                         }
@@ -94,10 +93,21 @@ TYPED_TEST(OctreeBuild, MinMaxEqualsExactCellRangeOfEveryChild) {
                     double lo, hi;
                     const bool has_cells = exact_cell_range<T>(dims, co, half, [&](uint32_t x, uint32_t y, uint32_t z) { return v.at(x, y, z); }, lo, hi);
                     if (!has_cells) {
-                        EXPECT_GT(n.min[c], n.max[c]) << "child without data cells must have an empty range";
+                        EXPECT_TRUE(n.bounds.empty(c)) << "child without data cells must have an empty range";
+                    } else if constexpr (sizeof(T) == 1) {   // exact bounds (octree.h)
+                        EXPECT_EQ(n.bounds.lower(c), lo) << "depth " << d << " child " << c;
+                        EXPECT_EQ(n.bounds.upper(c), hi) << "depth " << d << " child " << c;
                     } else {
-                        EXPECT_EQ(double(n.min[c]), lo) << "depth " << d << " child " << c;
-                        EXPECT_EQ(double(n.max[c]), hi) << "depth " << d << " child " << c;
+                        // 8-bit codes in the node's exact range: they contain the cell range and
+                        // are the tightest codes that do (within one code step of it).
+                        ASSERT_FALSE(n.bounds.empty(c));
+                        const double step = (double(n.bounds.hi) - double(n.bounds.lo)) / 255;
+                        EXPECT_LE(n.bounds.lower(c), lo) << "depth " << d << " child " << c;
+                        EXPECT_GE(n.bounds.upper(c), hi) << "depth " << d << " child " << c;
+                        EXPECT_LE(lo - n.bounds.lower(c), step * 1.001) << "depth " << d << " child " << c;
+                        EXPECT_LE(n.bounds.upper(c) - hi, step * 1.001) << "depth " << d << " child " << c;
+                        EXPECT_LE(double(n.bounds.lo), lo);
+                        EXPECT_GE(double(n.bounds.hi), hi);
                     }
                     ++checked;
                 }
@@ -136,8 +146,8 @@ TYPED_TEST(OctreeBuild, ToleranceNeverExceedsEpsAndRangesStillBoundStoredCells) 
                 const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
                 double lo, hi;
                 if (exact_cell_range<T>(dims, co, half, [&](uint32_t x, uint32_t y, uint32_t z) { return tree.point_locate({x, y, z}); }, lo, hi)) {
-                    EXPECT_LE(double(n.min[c]), lo);
-                    EXPECT_GE(double(n.max[c]), hi);
+                    EXPECT_LE(n.bounds.lower(c), lo);
+                    EXPECT_GE(n.bounds.upper(c), hi);
                 }
             }
         });
