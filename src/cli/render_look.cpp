@@ -17,7 +17,13 @@ const char* const kLookUsage =
     "  --clip NX,NY,NZ,D         keep the half-space NX*x + NY*y + NZ*z <= D (world units) and cut the\n"
     "                            rest away, for every ray; repeatable (the kept part is the intersection)\n";
 
-LookFlags LookFlags::take(Args& args) {
+void LookFlags::declare(FlagSpec& spec) {
+    spec.values.insert(spec.values.end(), {"--ao", "--ao-distance"});
+    spec.lists.insert(spec.lists.end(), {"--opacity", "--clip"});
+    spec.switches.emplace_back("--shadows");
+}
+
+LookFlags LookFlags::take(const Flags& args) {
     LookFlags f;
     f.look.shadows = args.flag("--shadows");
     if (const auto ao = args.value("--ao")) f.look.ao_samples = int(parse_int(*ao, "--ao", 0, kMaxAoSamples));

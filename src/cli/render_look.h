@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "cli/common/json.h"
 #include "octiso/look.h"
 #include "octiso/render.h"
@@ -16,8 +17,10 @@ namespace octiso::cli {
 struct LookFlags {
     Look look;
     std::vector<ClipPlane> clip_planes;
-    /// Consumes the look flags from `args`; throws Error(flag, ...) for a malformed value.
-    static LookFlags take(Args& args);
+    /// Adds the look flags to `spec` (--opacity and --clip repeatable).
+    static void declare(FlagSpec& spec);
+    /// Reads the look flags from `args`; throws Error(flag, ...) for a malformed value.
+    static LookFlags take(const Flags& args);
 };
 
 /// The help text of these flags (one block of octiso-render --help).

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "cli/common/json.h"
 #include "cli/common/output_path.h"
 #include "cli/common/progress.h"
@@ -43,11 +44,15 @@ const char* kUsage =
     "Ray-traces the isosurfaces f = V of a .oct file (octiso-info FILE.oct shows the data range; an\n"
     "isovalue outside it is refused).\n"
     "\n"
+    "Isovalues:\n"
+    "  --iso V[,V...]            isovalues in the data's real values, up to 8 (required; no default)\n"
     "Outputs (at least one):\n"
     "  -o, --output OUT.png      colour image, 8-bit sRGB unless the format is float (.exr, .tif)\n"
     "  --depth DEPTH.exr         world distance to the first hit, +inf on a miss (float formats only)\n"
     "  --normal NORMAL.exr       world unit normal facing the ray, 0,0,0 on a miss (8-bit: n/2 + 1/2)\n"
     "  --json                    one JSON object on stdout (camera, timings in seconds); report on stderr\n"
+    "  --debug-pixel X,Y         no image: prints the path of pixel X,Y (column, row from the top-left) of the\n"
+    "                            first step through the tree instead (default: off)\n"
     "Series:\n"
     "  --steps A:B               steps A..B of a time series (default: step 0); names then hold one\n"
     "                            printf field (frame_%04d.png). A name with a %d field and no --steps\n"
@@ -77,35 +82,37 @@ const char* kUsage =
     "                            same image)\n"
     "  --isa auto|baseline|avx2  traversal kernel: auto = AVX2 where the CPU has it (default; same image)\n"
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
+    "  --distribute steps|image|data  under mpirun: frames dealt to free ranks, each frame's tiles shared, or\n"
+    "                            the volume cut into slabs and composited by depth (default steps)\n"
     "  --version, -h/--help\n";
 
 int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     using cli::Distribute, cli::FrameRecord, cli::RankExchange;
-    cli::Args args(argv);
-    if (args.flag("--help") || args.flag("-h")) {
-        if (ranks.rank == 0) std::cout << kUsage << cli::kLookUsage;
-        return 0;
-    }
-    if (argv.empty()) {   // the same in every tool: the help, as a usage error
-        if (ranks.rank == 0) std::cerr << kUsage << cli::kLookUsage;
-        return 2;
-    }
+    // --help (stdout, 0) and no argument (stderr, 2) as in every tool; under mpirun one rank prints.
+    const std::string usage = std::string(kUsage) + cli::kLookUsage;
+    if (const auto status = cli::answer_help(argv, ranks.rank == 0 ? usage : std::string())) return *status;
+    cli::FlagSpec spec{{"-o,--output", "--iso", "--steps", "--depth", "--normal", "--threads", "--root-finder", "--iterations", "--spp",
+                        "--shading", "--background", "--traversal", "--isa", "--debug-pixel", "--distribute"},
+                       {"--colour"},
+                       {"--no-embree", "--json"}};
+    cli::CameraFlags::declare(spec);
+    cli::LookFlags::declare(spec);   // issue 17 item 7
+    const cli::Flags args(argv, spec);
     const auto iso_text = args.value("--iso");
-    const auto out_path = args.value("--output", "-o");
+    const auto out_path = args.value("--output");
     const cli::CameraFlags camera_flags = cli::CameraFlags::take(args);
     const auto steps = args.value("--steps"), depth_path = args.value("--depth");
     const auto normal_path = args.value("--normal"), threads = args.value("--threads");
     const auto root_finder = args.value("--root-finder"), iterations = args.value("--iterations");
     const auto spp_text = args.value("--spp");
     const auto shading_text = args.value("--shading"), background_text = args.value("--background");
-    const std::vector<std::string> colour_texts = args.values("--colour");
+    const std::vector<std::string>& colour_texts = args.values("--colour");
     const bool no_embree = args.flag("--no-embree"), json = args.flag("--json");
     const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
     const auto distribute_text = args.value("--distribute");
-    const cli::LookFlags look_flags = cli::LookFlags::take(args);   // issue 17 item 7
-    const std::vector<std::string> inputs = args.positional();
-    args.finish();
+    const cli::LookFlags look_flags = cli::LookFlags::take(args);
+    const std::vector<std::string>& inputs = args.positional();
     if (inputs.size() != 1) throw Error("octiso-render", "expected exactly one FILE.oct (octiso-render --help lists every flag)");
     if (!iso_text) throw Error("--iso", "is required (one or more isovalues, e.g. --iso 40,120)");
     if (!out_path && !depth_path && !normal_path && !debug_pixel) throw Error("-o", "is required (or at least --depth or --normal)");
