@@ -19,6 +19,7 @@
 #include "cli/common/report.h"
 #include "cli/render_camera.h"
 #include "cli/render_look.h"
+#include "cli/render_progress.h"
 #include "cli/render_ranks.h"
 #include "util/process_memory.h"
 #include "octiso/antialias.h"
@@ -82,6 +83,8 @@ const char* kUsage =
     "                            same image)\n"
     "  --isa auto|baseline|avx2  traversal kernel: auto = AVX2 where the CPU has it (default; same image)\n"
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
+    "  --progress                draw the progress line (bar, ETA) on stderr even when it is not a terminal\n"
+    "                            (default: only on a terminal, for a series at once, for one frame after 1 s)\n"
     "  --distribute steps|image|data  under mpirun: frames dealt to free ranks, each frame's tiles shared, or\n"
     "                            the volume cut into slabs and composited by depth (default steps)\n"
     "  --version, -h/--help\n";
@@ -94,7 +97,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     cli::FlagSpec spec{{"-o,--output", "--iso", "--steps", "--depth", "--normal", "--threads", "--root-finder", "--iterations", "--spp",
                         "--shading", "--background", "--traversal", "--isa", "--debug-pixel", "--distribute"},
                        {"--colour"},
-                       {"--no-embree", "--json"}};
+                       {"--no-embree", "--json", "--progress"}};
     cli::CameraFlags::declare(spec);
     cli::LookFlags::declare(spec);   // issue 17 item 7
     const cli::Flags args(argv, spec);
@@ -107,7 +110,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     const auto spp_text = args.value("--spp");
     const auto shading_text = args.value("--shading"), background_text = args.value("--background");
     const std::vector<std::string>& colour_texts = args.values("--colour");
-    const bool no_embree = args.flag("--no-embree"), json = args.flag("--json");
+    const bool no_embree = args.flag("--no-embree"), json = args.flag("--json"), progress_forced = args.flag("--progress");
     const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
     const auto distribute_text = args.value("--distribute");
@@ -292,7 +295,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         j.begin_object().key("eye").array(c.eye).key("look").array(c.look).key("up").array(c.up);
         j.field("fov", c.fov_deg).field("width", c.width).field("height", c.height).end_object();
     };
-    cli::ProgressLine progress = cli::ProgressLine::on_stderr(root && rank_count == 1 && jobs.size() > 1, 0.0);
+    // Issue 17 item 5: one line for the run, frames and the tiles inside each (cli/render_progress.h).
+    const bool one_process = root && rank_count == 1;
+    cli::RenderProgress progress(one_process, progress_forced && one_process, jobs.size(), spp);
     std::optional<Renderer> renderer;
     std::optional<AnyOctree> step_tree;
     std::optional<LookShader> look_shader;
@@ -328,10 +333,12 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                 const TileGrid grid = renderer->tile_grid(c.width, c.height);
                 stats = renderer->render_tiles(c, ranks.tiles_of(grid.count()), f);
             } else {
-                stats = renderer->render(c, f);
+                stats = progress.trace(*renderer, c, f, n);   // in batches of tiles while a progress line is on
             }
+            progress.shading();
             if (deferred && look_shader) record.look.add(look_shader->shade(c, shading, f));
             else if (deferred) shade_frame(*step_tree, options.isovalues, c, shading, f);
+            progress.sample_done();
             if (split_frames) {
                 const RankExchange cost = distribute == Distribute::image
                                               ? ranks.gather_tiles(renderer->tile_grid(c.width, c.height), out_path.has_value(),
@@ -360,6 +367,8 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         }
         // The effective camera, as flags that reproduce it (issue 17: a view can be pasted back);
         // after the first image is written, so that a failure stays one line on stderr.
+        if (root && records.empty()) progress.break_line();
+        if ((root || !split_frames) && (!series || !::isatty(2))) progress.break_line();
         if (root && records.empty())
             std::fprintf(stderr, "camera: %s%s\n", cli::camera_flags_text(cameras[0]).c_str(),
                          orbit ? (" (first of " + std::to_string(cameras.size()) + " orbit frames)").c_str() : "");
@@ -374,8 +383,6 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                          orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
         if (look_shader && (root || !split_frames) && (!series || !::isatty(2))) cli::print_look_stats(record.look);
         records.push_back(record);
-        progress.update(double(records.size()), double(jobs.size()),
-                        std::to_string(records.size()) + "/" + std::to_string(jobs.size()) + " frames");
     };
     if (!split_frames && rank_count > 1) {
         // Series across ranks: rank 0 deals the jobs one at a time to whichever rank is free.
@@ -383,7 +390,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     } else {
         for (size_t n = 0; n < jobs.size(); ++n) render_job(n);
     }
-    progress.finish();
+    progress.break_line();
     const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     // Rank 0 learns every rank's frames: all of them (steps), or each rank's share of each frame.
     // Sort-last: how much of the file this rank mapped (issue 15: its brick's pages and little
