@@ -23,6 +23,7 @@
 #include "cli/render_ranks.h"
 #include "util/process_memory.h"
 #include "octiso/antialias.h"
+#include "octiso/clip_cap.h"
 #include "octiso/bricks.h"
 #include "octiso/depth_composite.h"
 #include "octiso/shading.h"
@@ -124,6 +125,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     if (distribute == Distribute::data && look_flags.look.active())
         throw Error("--distribute", "data traces each slab alone, so shadow, AO and translucent-layer rays cannot cross "
                                     "into other slabs; use --distribute image or steps with --shadows, --ao or --opacity");
+    if (distribute == Distribute::data && look_flags.clip_cap)
+        throw Error("--distribute", "data traces each slab alone, and a cap needs the field where each ray enters the kept part; "
+                                    "use --distribute image or steps with --clip-cap");
     if (distribute_text && !ranks.mpi_built())
         throw Error("--distribute", "this octiso-render was built without MPI (install libopenmpi-dev and rebuild)");
 
@@ -165,9 +169,12 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     validate_look(look, options.isovalues.size(), shading.model);
     // The colour is shaded after tracing, from the depth and normal AOVs (shading.h), unless the
     // Renderer's own headlight is asked for as it is: that path stays bit for bit the old image.
-    const bool deferred = out_path && (shading.model == ShadingModel::kit || background_text || !colour_texts.empty() || look.active());
+    // --clip-cap draws its faces into the depth and normal AOVs (octiso/clip_cap.h), so it shades deferred too.
+    const bool deferred = out_path && (shading.model == ShadingModel::kit || background_text || !colour_texts.empty() || look.active() ||
+                                       look_flags.clip_cap);
     RenderOptions trace_options = options;
     if (deferred) trace_options.want_colour = false, trace_options.want_depth = trace_options.want_normal = true;
+    if (look_flags.clip_cap) trace_options.want_depth = true;
 
     // Everything about the outputs is checked before the first frame is rendered.
     const auto file = std::make_shared<const OctFile>(OctFile::open(inputs[0]));
@@ -177,6 +184,8 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     for (double& v : options.isovalues) v = info.value_scale.stored(v);
     trace_options.isovalues = options.isovalues;
     const std::vector<Camera> cameras = cli::cameras_for(camera_flags, info);
+    // Inside is value >= V in real values: in stored values too unless the scale's slope is negative.
+    if (look_flags.clip_cap) shading.cap = ClipCap{options.clip_planes, !(info.value_scale.slope < 0)};
     const bool orbit = camera_flags.orbit.has_value();
     long long first = 0, last = 0;
     const auto has_field = [](const std::optional<std::string>& name) { return name && name->find('%') != std::string::npos; };
@@ -336,6 +345,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                 stats = progress.trace(*renderer, c, f, n);   // in batches of tiles while a progress line is on
             }
             progress.shading();
+            if (shading.cap) cap_clip_planes(*step_tree, options.isovalues, *shading.cap, c, f);
             if (deferred && look_shader) record.look.add(look_shader->shade(c, shading, f));
             else if (deferred) shade_frame(*step_tree, options.isovalues, c, shading, f);
             progress.sample_done();
@@ -412,7 +422,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
-        cli::write_look_json(j, look, options.clip_planes);   // issue 17 item 7
+        cli::write_look_json(j, look_flags);   // issue 17 item 7
         j.field("ranks", rank_count).field("distribute", std::string(distribute_name(distribute)));
         j.key("camera");
         camera_json(cameras[0]);

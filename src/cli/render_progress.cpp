@@ -27,7 +27,7 @@ RenderStats render_in_batches(const Renderer& renderer, const Camera& camera, Fr
         done += n;
         after_batch(done, count);
         // The next batch takes about batch_seconds at the rate so far: few barriers per second
-        // (each one idles the threads that finish their tiles first). scripts/progress_cost.py,
+        // (each one idles the threads that finish their tiles first). scripts/flag_cost.py --flag=--progress,
         // ch2better --iso 80.5, 8 interleaved pairs: 2048^2 on 2 threads 1.7026 s with batches
         // against 1.7054 s without (median frame), 1536^2 on 1 thread 1.0129 against 1.0068:
         // within noise (BENCHMARKS.md, "Progress inside a frame").

@@ -21,7 +21,7 @@ const ToolFlags kTools[] = {
      {"-o, --output", "--depth", "--normal", "--json", "--steps", "--view", "--azimuth", "--elevation", "--zoom", "--orbit", "--eye",
       "--look", "--up", "--fov", "--size", "--spp", "--shading", "--background", "--colour", "--root-finder", "--iterations",
       "--no-embree", "--threads", "--debug-pixel", "--version", "--help", "--iso", "--traversal", "--isa", "--distribute", "--shadows",
-      "--ao", "--ao-distance", "--opacity", "--clip"}},
+      "--ao", "--ao-distance", "--opacity", "--clip", "--clip-cap", "--progress"}},
     {"octiso-info", {"--json", "--bins", "--verify", "--extract-raw", "--step", "--endian", "--version", "--help"}},
     {"octiso-convert",
      {"-o, --output", "--dims", "--type", "--endian", "--offset", "--spacing", "--origin", "--iso-range", "--tolerance", "--nan-as",
