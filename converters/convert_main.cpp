@@ -284,16 +284,7 @@ int convert_sparse_spheres(const cli::Flags& args, uint32_t n) {
 }
 
 int run(std::vector<std::string>& argv) {
-    // --help wins over every other argument, as --version does in run_main.
-    for (const std::string& a : argv)
-        if (a == "--help" || a == "-h") {
-            std::cout << kUsage;
-            return 0;
-        }
-    if (argv.empty()) {   // the same in every tool: the help, as a usage error
-        std::cerr << kUsage;
-        return 2;
-    }
+    if (const auto status = cli::answer_help(argv, kUsage)) return *status;
     const cli::Flags args(argv,
                           {"-o,--output", "--synthetic", "--steps", "--dims", "--type", "--endian", "--offset", "--spacing",
                            "--origin", "--array", "--iso-range", "--tolerance", "--nan-as", "--threads", "--memory"},

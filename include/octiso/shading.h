@@ -13,6 +13,7 @@
 
 #include "octiso/any_octree.h"
 #include "octiso/camera.h"
+#include "octiso/clip_cap.h"
 #include "octiso/frame.h"
 
 namespace octiso {
@@ -28,6 +29,9 @@ struct Shading {
     std::array<float, 3> background{0.015f, 0.017f, 0.022f};   ///< the Renderer's background
     /// colours[i], where given, replaces the albedo of isovalue i (default: the Renderer's palette).
     std::vector<std::optional<std::array<float, 3>>> colours;
+    /// --clip-cap: the caps cap_clip_planes drew into the frame; a hit on one shows the innermost
+    /// isovalue whose inside holds it, not the isovalue nearest to the field there.
+    std::optional<ClipCap> cap;
 };
 
 /// Fills frame.rgb (8-bit sRGB, resized to the frame) from frame.depth and frame.normal, both

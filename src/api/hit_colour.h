@@ -7,9 +7,12 @@
 #include <cmath>
 #include <vector>
 
+#include "math/ray.h"
 #include "math/vec.h"
+#include "octiso/clip_cap.h"
 #include "octiso/octree.h"
 #include "octiso/shading.h"
+#include "render/clip.h"
 #include "render/shade.h"
 
 namespace octiso {
@@ -42,6 +45,23 @@ inline int nearest_isovalue(double v, const std::vector<double>& isovalues) {
     for (int i = 1; i < int(isovalues.size()); ++i)
         if (std::fabs(v - isovalues[size_t(i)]) < std::fabs(v - isovalues[size_t(best)])) best = i;
     return best;
+}
+
+/// The isovalue a hit at depth `t` (the AOV's float) along the primary `ray` (unclipped) shows: the
+/// nearest to the field there; on a cap of `cap` (the ray enters through a plane at that very t,
+/// clip_cap.h) the innermost isovalue whose inside holds the point, as cap_clip_planes chose it.
+template <typename T>
+inline int shown_isovalue(const Octree<T>& tree, const Placement& placement, const std::vector<double>& isovalues, const Ray& ray,
+                          float t, const ClipCap* cap) {
+    if (isovalues.size() < 2) return 0;
+    const Vec3 p{ray.origin[0] + double(t) * ray.dir[0], ray.origin[1] + double(t) * ray.dir[1], ray.origin[2] + double(t) * ray.dir[2]};
+    const double v = field_at(tree, placement, p);
+    if (cap) {
+        const ClipEntry entry = clip_entry(cap->planes, ray);
+        if (entry.plane >= 0 && float(entry.t) == t)
+            if (const int inner = cap_isovalue(v, isovalues, cap->inside_above); inner >= 0) return inner;
+    }
+    return nearest_isovalue(v, isovalues);
 }
 
 /// The linear albedo of isovalue `iso`: the caller's colour where given, else the palette's.

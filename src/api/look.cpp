@@ -155,10 +155,8 @@ LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame&
                                     TraceHit& h = layers.hit[0];
                                     h.t = double(frame.depth[i]);
                                     h.normal = {frame.normal[3 * i], frame.normal[3 * i + 1], frame.normal[3 * i + 2]};
-                                    h.iso_index = m.options.isovalues.size() > 1
-                                                      ? nearest_isovalue(field_at(octree, m.tree.placement(), point_at(b.ray, h.t)),
-                                                                         m.options.isovalues)
-                                                      : 0;
+                                    h.iso_index = shown_isovalue(octree, m.tree.placement(), m.options.isovalues, pinhole.ray(px, py),
+                                                                 frame.depth[i], shading.cap ? &*shading.cap : nullptr);
                                     layers.count = 1;
                                 }
                                 for (int k = 0; k < layers.count; ++k) b.key[k] = 1.0;

@@ -48,12 +48,7 @@ void shade_frame(const AnyOctree& tree, const std::vector<double>& isovalues, co
                 }
                 const Ray ray = pinhole.ray(px, py);
                 const Vec3 normal{frame.normal[3 * i], frame.normal[3 * i + 1], frame.normal[3 * i + 2]};
-                int iso = 0;
-                if (isovalues.size() > 1) {
-                    const Vec3 p{ray.origin[0] + double(t) * ray.dir[0], ray.origin[1] + double(t) * ray.dir[1],
-                                 ray.origin[2] + double(t) * ray.dir[2]};
-                    iso = nearest_isovalue(field_at(octree, tree.placement(), p), isovalues);
-                }
+                const int iso = shown_isovalue(octree, tree.placement(), isovalues, ray, t, shading.cap ? &*shading.cap : nullptr);
                 const float* albedo = albedo_of(shading, iso);
                 std::array<double, 3> rgb;
                 if (shading.model == ShadingModel::kit) {

@@ -314,15 +314,7 @@ void json_report(std::ostream& os, const OctFile& file, const std::vector<StepSi
 
 int main(int argc, char** argv) {
     return octiso::cli::run_main("octiso-info", argc, argv, [](std::vector<std::string>& argv_rest) {
-        for (const std::string& a : argv_rest)   // --help wins over every other argument
-            if (a == "--help" || a == "-h") {
-                std::cout << kUsage;
-                return 0;
-            }
-        if (argv_rest.empty()) {   // the same in every tool: the help, as a usage error
-            std::cerr << kUsage;
-            return 2;
-        }
+        if (const auto status = cli::answer_help(argv_rest, kUsage)) return *status;
         const cli::Flags args(argv_rest, {"--extract-raw", "--extract", "--step", "--endian", "--bins"}, {"--json", "--verify"});
         const bool json = args.flag("--json");
         const bool verify = args.flag("--verify");

@@ -5,7 +5,12 @@
 
 namespace octiso::cli {
 
-CameraFlags CameraFlags::take(Args& args) {
+void CameraFlags::declare(FlagSpec& spec) {
+    for (const char* name : {"--eye", "--look", "--up", "--fov", "--size", "--view", "--azimuth", "--elevation", "--zoom", "--orbit"})
+        spec.values.emplace_back(name);
+}
+
+CameraFlags CameraFlags::take(const Flags& args) {
     CameraFlags f;
     f.eye = args.value("--eye"), f.look = args.value("--look"), f.up = args.value("--up"), f.fov = args.value("--fov");
     f.size = args.value("--size"), f.view = args.value("--view"), f.azimuth = args.value("--azimuth");

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "octiso/camera.h"
 #include "octiso/oct_file.h"
 
@@ -16,8 +17,10 @@ namespace octiso::cli {
 
 struct CameraFlags {
     std::optional<std::string> eye, look, up, fov, size, view, azimuth, elevation, zoom, orbit;
-    /// Consumes the camera flags from `args`.
-    static CameraFlags take(Args& args);
+    /// Adds the camera flags to `spec` (all value flags).
+    static void declare(FlagSpec& spec);
+    /// The camera flags as given (unparsed: cameras_for() parses them against the file).
+    static CameraFlags take(const Flags& args);
 };
 
 /// The cameras of the run: one, or --orbit N of them (azimuth start + 360 i / N). Throws

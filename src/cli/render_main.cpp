@@ -12,15 +12,18 @@
 #include <utility>
 
 #include "cli/common/cli.h"
+#include "cli/common/flags.h"
 #include "cli/common/json.h"
 #include "cli/common/output_path.h"
 #include "cli/common/progress.h"
 #include "cli/common/report.h"
 #include "cli/render_camera.h"
 #include "cli/render_look.h"
+#include "cli/render_progress.h"
 #include "cli/render_ranks.h"
 #include "util/process_memory.h"
 #include "octiso/antialias.h"
+#include "octiso/clip_cap.h"
 #include "octiso/bricks.h"
 #include "octiso/depth_composite.h"
 #include "octiso/shading.h"
@@ -43,11 +46,15 @@ const char* kUsage =
     "Ray-traces the isosurfaces f = V of a .oct file (octiso-info FILE.oct shows the data range; an\n"
     "isovalue outside it is refused).\n"
     "\n"
+    "Isovalues:\n"
+    "  --iso V[,V...]            isovalues in the data's real values, up to 8 (required; no default)\n"
     "Outputs (at least one):\n"
     "  -o, --output OUT.png      colour image, 8-bit sRGB unless the format is float (.exr, .tif)\n"
     "  --depth DEPTH.exr         world distance to the first hit, +inf on a miss (float formats only)\n"
     "  --normal NORMAL.exr       world unit normal facing the ray, 0,0,0 on a miss (8-bit: n/2 + 1/2)\n"
     "  --json                    one JSON object on stdout (camera, timings in seconds); report on stderr\n"
+    "  --debug-pixel X,Y         no image: prints the path of pixel X,Y (column, row from the top-left) of the\n"
+    "                            first step through the tree instead (default: off)\n"
     "Series:\n"
     "  --steps A:B               steps A..B of a time series (default: step 0); names then hold one\n"
     "                            printf field (frame_%04d.png). A name with a %d field and no --steps\n"
@@ -77,35 +84,39 @@ const char* kUsage =
     "                            same image)\n"
     "  --isa auto|baseline|avx2  traversal kernel: auto = AVX2 where the CPU has it (default; same image)\n"
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
+    "  --progress                draw the progress line (bar, ETA) on stderr even when it is not a terminal\n"
+    "                            (default: only on a terminal, for a series at once, for one frame after 1 s)\n"
+    "  --distribute steps|image|data  under mpirun: frames dealt to free ranks, each frame's tiles shared, or\n"
+    "                            the volume cut into slabs and composited by depth (default steps)\n"
     "  --version, -h/--help\n";
 
 int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     using cli::Distribute, cli::FrameRecord, cli::RankExchange;
-    cli::Args args(argv);
-    if (args.flag("--help") || args.flag("-h")) {
-        if (ranks.rank == 0) std::cout << kUsage << cli::kLookUsage;
-        return 0;
-    }
-    if (argv.empty()) {   // the same in every tool: the help, as a usage error
-        if (ranks.rank == 0) std::cerr << kUsage << cli::kLookUsage;
-        return 2;
-    }
+    // --help (stdout, 0) and no argument (stderr, 2) as in every tool; under mpirun one rank prints.
+    const std::string usage = std::string(kUsage) + cli::kLookUsage;
+    if (const auto status = cli::answer_help(argv, ranks.rank == 0 ? usage : std::string())) return *status;
+    cli::FlagSpec spec{{"-o,--output", "--iso", "--steps", "--depth", "--normal", "--threads", "--root-finder", "--iterations", "--spp",
+                        "--shading", "--background", "--traversal", "--isa", "--debug-pixel", "--distribute"},
+                       {"--colour"},
+                       {"--no-embree", "--json", "--progress"}};
+    cli::CameraFlags::declare(spec);
+    cli::LookFlags::declare(spec);   // issue 17 item 7
+    const cli::Flags args(argv, spec);
     const auto iso_text = args.value("--iso");
-    const auto out_path = args.value("--output", "-o");
+    const auto out_path = args.value("--output");
     const cli::CameraFlags camera_flags = cli::CameraFlags::take(args);
     const auto steps = args.value("--steps"), depth_path = args.value("--depth");
     const auto normal_path = args.value("--normal"), threads = args.value("--threads");
     const auto root_finder = args.value("--root-finder"), iterations = args.value("--iterations");
     const auto spp_text = args.value("--spp");
     const auto shading_text = args.value("--shading"), background_text = args.value("--background");
-    const std::vector<std::string> colour_texts = args.values("--colour");
-    const bool no_embree = args.flag("--no-embree"), json = args.flag("--json");
+    const std::vector<std::string>& colour_texts = args.values("--colour");
+    const bool no_embree = args.flag("--no-embree"), json = args.flag("--json"), progress_forced = args.flag("--progress");
     const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
     const auto distribute_text = args.value("--distribute");
-    const cli::LookFlags look_flags = cli::LookFlags::take(args);   // issue 17 item 7
-    const std::vector<std::string> inputs = args.positional();
-    args.finish();
+    const cli::LookFlags look_flags = cli::LookFlags::take(args);
+    const std::vector<std::string>& inputs = args.positional();
     if (inputs.size() != 1) throw Error("octiso-render", "expected exactly one FILE.oct (octiso-render --help lists every flag)");
     if (!iso_text) throw Error("--iso", "is required (one or more isovalues, e.g. --iso 40,120)");
     if (!out_path && !depth_path && !normal_path && !debug_pixel) throw Error("-o", "is required (or at least --depth or --normal)");
@@ -114,6 +125,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     if (distribute == Distribute::data && look_flags.look.active())
         throw Error("--distribute", "data traces each slab alone, so shadow, AO and translucent-layer rays cannot cross "
                                     "into other slabs; use --distribute image or steps with --shadows, --ao or --opacity");
+    if (distribute == Distribute::data && look_flags.clip_cap)
+        throw Error("--distribute", "data traces each slab alone, and a cap needs the field where each ray enters the kept part; "
+                                    "use --distribute image or steps with --clip-cap");
     if (distribute_text && !ranks.mpi_built())
         throw Error("--distribute", "this octiso-render was built without MPI (install libopenmpi-dev and rebuild)");
 
@@ -155,9 +169,12 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     validate_look(look, options.isovalues.size(), shading.model);
     // The colour is shaded after tracing, from the depth and normal AOVs (shading.h), unless the
     // Renderer's own headlight is asked for as it is: that path stays bit for bit the old image.
-    const bool deferred = out_path && (shading.model == ShadingModel::kit || background_text || !colour_texts.empty() || look.active());
+    // --clip-cap draws its faces into the depth and normal AOVs (octiso/clip_cap.h), so it shades deferred too.
+    const bool deferred = out_path && (shading.model == ShadingModel::kit || background_text || !colour_texts.empty() || look.active() ||
+                                       look_flags.clip_cap);
     RenderOptions trace_options = options;
     if (deferred) trace_options.want_colour = false, trace_options.want_depth = trace_options.want_normal = true;
+    if (look_flags.clip_cap) trace_options.want_depth = true;
 
     // Everything about the outputs is checked before the first frame is rendered.
     const auto file = std::make_shared<const OctFile>(OctFile::open(inputs[0]));
@@ -167,6 +184,8 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     for (double& v : options.isovalues) v = info.value_scale.stored(v);
     trace_options.isovalues = options.isovalues;
     const std::vector<Camera> cameras = cli::cameras_for(camera_flags, info);
+    // Inside is value >= V in real values: in stored values too unless the scale's slope is negative.
+    if (look_flags.clip_cap) shading.cap = ClipCap{options.clip_planes, !(info.value_scale.slope < 0)};
     const bool orbit = camera_flags.orbit.has_value();
     long long first = 0, last = 0;
     const auto has_field = [](const std::optional<std::string>& name) { return name && name->find('%') != std::string::npos; };
@@ -285,7 +304,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         j.begin_object().key("eye").array(c.eye).key("look").array(c.look).key("up").array(c.up);
         j.field("fov", c.fov_deg).field("width", c.width).field("height", c.height).end_object();
     };
-    cli::ProgressLine progress = cli::ProgressLine::on_stderr(root && rank_count == 1 && jobs.size() > 1, 0.0);
+    // Issue 17 item 5: one line for the run, frames and the tiles inside each (cli/render_progress.h).
+    const bool one_process = root && rank_count == 1;
+    cli::RenderProgress progress(one_process, progress_forced && one_process, jobs.size(), spp);
     std::optional<Renderer> renderer;
     std::optional<AnyOctree> step_tree;
     std::optional<LookShader> look_shader;
@@ -321,10 +342,13 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                 const TileGrid grid = renderer->tile_grid(c.width, c.height);
                 stats = renderer->render_tiles(c, ranks.tiles_of(grid.count()), f);
             } else {
-                stats = renderer->render(c, f);
+                stats = progress.trace(*renderer, c, f, n);   // in batches of tiles while a progress line is on
             }
+            progress.shading();
+            if (shading.cap) cap_clip_planes(*step_tree, options.isovalues, *shading.cap, c, f);
             if (deferred && look_shader) record.look.add(look_shader->shade(c, shading, f));
             else if (deferred) shade_frame(*step_tree, options.isovalues, c, shading, f);
+            progress.sample_done();
             if (split_frames) {
                 const RankExchange cost = distribute == Distribute::image
                                               ? ranks.gather_tiles(renderer->tile_grid(c.width, c.height), out_path.has_value(),
@@ -353,6 +377,8 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         }
         // The effective camera, as flags that reproduce it (issue 17: a view can be pasted back);
         // after the first image is written, so that a failure stays one line on stderr.
+        if (root && records.empty()) progress.break_line();
+        if ((root || !split_frames) && (!series || !::isatty(2))) progress.break_line();
         if (root && records.empty())
             std::fprintf(stderr, "camera: %s%s\n", cli::camera_flags_text(cameras[0]).c_str(),
                          orbit ? (" (first of " + std::to_string(cameras.size()) + " orbit frames)").c_str() : "");
@@ -367,8 +393,6 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                          orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
         if (look_shader && (root || !split_frames) && (!series || !::isatty(2))) cli::print_look_stats(record.look);
         records.push_back(record);
-        progress.update(double(records.size()), double(jobs.size()),
-                        std::to_string(records.size()) + "/" + std::to_string(jobs.size()) + " frames");
     };
     if (!split_frames && rank_count > 1) {
         // Series across ranks: rank 0 deals the jobs one at a time to whichever rank is free.
@@ -376,7 +400,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     } else {
         for (size_t n = 0; n < jobs.size(); ++n) render_job(n);
     }
-    progress.finish();
+    progress.break_line();
     const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     // Rank 0 learns every rank's frames: all of them (steps), or each rank's share of each frame.
     // Sort-last: how much of the file this rank mapped (issue 15: its brick's pages and little
@@ -398,7 +422,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
-        cli::write_look_json(j, look, options.clip_planes);   // issue 17 item 7
+        cli::write_look_json(j, look_flags);   // issue 17 item 7
         j.field("ranks", rank_count).field("distribute", std::string(distribute_name(distribute)));
         j.key("camera");
         camera_json(cameras[0]);

@@ -33,4 +33,32 @@ inline void clip_ray(std::span<const ClipPlane> planes, Ray& ray) {
     }
 }
 
+/// Where a ray enters the kept set through one of the planes (--clip-cap, api/clip_cap.cpp):
+/// `t` is the t_min clip_ray() leaves and `plane` the index of the plane that set it, or -1 when no
+/// plane did (the ray starts on the kept side of every entering plane) or the kept interval is
+/// empty. The same arithmetic as clip_ray, so `t` is its t_min bit for bit.
+struct ClipEntry {
+    double t = 0;
+    int plane = -1;
+};
+
+inline ClipEntry clip_entry(std::span<const ClipPlane> planes, const Ray& ray) {
+    ClipEntry e{ray.t_min, -1};
+    double t_max = ray.t_max;
+    for (size_t i = 0; i < planes.size(); ++i) {
+        const ClipPlane& c = planes[i];
+        const double s0 = vec_dot(c.normal, ray.origin) - c.d;
+        const double s1 = vec_dot(c.normal, ray.dir);
+        if (s1 == 0) {
+            if (s0 > 0) return {std::numeric_limits<double>::infinity(), -1};
+            continue;
+        }
+        const double t = -s0 / s1;
+        if (s1 > 0) t_max = std::min(t_max, t);
+        else if (t > e.t) e = {t, int(i)};   // std::max in clip_ray: a tie keeps the earlier plane's t, the same value
+    }
+    if (!(e.t <= t_max)) e.plane = -1;
+    return e;
+}
+
 }  // namespace octiso

@@ -80,6 +80,44 @@ TEST_F(LookCli, ClipCutsTheDepthAtThePlane) {
     EXPECT_EQ(image("all.png").pixels, image("whole.png").pixels);
 }
 
+TEST_F(LookCli, ClipCapDrawsTheCutFaceAtThePlane) {
+    // As above, seen from above, cut at z <= 16 (at z = 12 the Marschner-Lobb field is 0.4 or more
+    // everywhere, at 16 it spans 0.2 .. 0.4): with --clip-cap the cut face is drawn where the field
+    // there is inside an isovalue (value >= 0.3), nearer than what the open cut shows, never above the plane.
+    const std::string cam = "--eye 12,12,60 --look 12,12,0 --up 0,1,0 --fov 30 --clip 0,0,1,16 ";
+    const ToolRun cut = render(cam, "open"), capped = render(cam + "--clip-cap", "capped");
+    ASSERT_EQ(cut.status, 0) << cut.err;
+    ASSERT_EQ(capped.status, 0) << capped.err;
+    EXPECT_NE(capped.out.find("\"clip_cap\":true"), std::string::npos) << capped.out;
+    const FloatImage a = image("open.exr"), b = image("capped.exr");
+    int nearer = 0, same = 0;
+    for (size_t i = 0; i < b.pixels.size(); ++i) {
+        if (!std::isfinite(b.pixels[i])) {
+            EXPECT_FALSE(std::isfinite(a.pixels[i])) << "a cap never removes a hit: pixel " << i;
+            continue;
+        }
+        EXPECT_GE(b.pixels[i], 44.0f * 0.9999f) << "pixel " << i;   // the plane lies at t >= 44
+        if (b.pixels[i] == a.pixels[i]) ++same;
+        else {
+            EXPECT_TRUE(!std::isfinite(a.pixels[i]) || b.pixels[i] < a.pixels[i]) << "pixel " << i;
+            ++nearer;
+        }
+    }
+    EXPECT_GT(nearer, 50) << "the cap covers the inside of the cut";
+    EXPECT_GT(same, 50) << "outside the surfaces the cut stays open";
+    EXPECT_NE(image("capped.png").pixels, image("open.png").pixels);
+    // Refused: a cap without a plane, and with translucent layers.
+    for (const char* bad : {"--clip-cap", "--clip 0,0,1,12 --clip-cap --opacity 0.5"}) {
+        SCOPED_TRACE(bad);
+        const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 0.3,0.6 --size 16x16 " + std::string(bad) + " -o '" +
+                                                        dir_.file("bad.png") + "'");
+        EXPECT_EQ(r.status, 2) << r.err;
+        EXPECT_EQ(r.err_lines(), 1) << r.err;
+        EXPECT_NE(r.err.find("--clip-cap"), std::string::npos) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(dir_.file("bad.png")));
+    }
+}
+
 TEST_F(LookCli, BadLookFlagsExitTwoAndWriteNothing) {
     ScratchDir out("octiso_look_bad");
     for (const char* bad : {"--opacity 1.5", "--opacity x", "--opacity 0.5 --opacity 0.5 --opacity 0.5", "--ao -1", "--ao 257",

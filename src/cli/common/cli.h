@@ -1,6 +1,7 @@
 // What every octiso command-line tool shares: turning exceptions into one stderr line and the
-// exit status of CONVENTIONS 3, a small flag parser that names the flag in every error, and the
-// parsers for the value forms the contract uses (X,Y,Z vectors, WxH sizes, A:B step ranges).
+// exit status of CONVENTIONS 3, and the parsers for the value forms the contract uses (X,Y,Z
+// vectors, WxH sizes, A:B step ranges). The tools parse flags with cli::Flags (flags.h, CLI11);
+// the small hand-written cli::Args here is left to octiso-bench's subcommands.
 #pragma once
 
 #include <array>
@@ -19,8 +20,8 @@ namespace octiso::cli {
 /// --version among the arguments it prints "TOOL VERSION" on stdout and returns 0 instead.
 int run_main(const char* tool, int argc, char** argv, const std::function<int(std::vector<std::string>&)>& body);
 
-/// Flags are "--name value" or "--name=value"; everything not starting with "--" (or "-o") is
-/// positional. Unknown flags are an error at finish().
+/// octiso-bench's flag reader. Flags are "--name value" or "--name=value"; everything not
+/// starting with "--" (or "-o") is positional. Unknown flags are an error at finish().
 class Args {
 public:
     explicit Args(std::vector<std::string> argv);

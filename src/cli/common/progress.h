@@ -1,7 +1,8 @@
 // ProgressLine: the one progress display of the tools (issue 17 item 5): a bar, done/total, a
 // detail the caller chooses and an ETA, redrawn in place on stderr. TTY-aware: nothing at all is
 // written when stderr is not a terminal (logs, pipes, tests), so reports stay line-oriented.
-// octiso-convert (slabs read, steps built) and octiso-render (series and orbit frames) use it.
+// octiso-convert (slabs read, steps built) and octiso-render (frames, and tiles inside a frame:
+// cli/render_progress.h) use it.
 #pragma once
 
 #include <chrono>
@@ -30,6 +31,7 @@ public:
     /// Ends the line if anything was drawn, so that the next message starts on a line of its own.
     void finish();
     bool shown() const { return shown_; }
+    bool enabled() const { return enabled_; }
 
     /// The line drawn for `done` of `total` after `elapsed_s` seconds (without the leading \r).
     static std::string text(double done, double total, double elapsed_s, const std::string& detail);

@@ -41,6 +41,29 @@ TEST(Flags, UsageErrorsNameTheFlag) {
     expect_error({"a", "--origin"}, "--origin", "needs a value");
     expect_error({"a", "--origin", "1", "--origin", "2"}, "--origin", "given more than once");
     expect_error({"a", "-o", "x", "--output", "y"}, "--output", "given more than once");
+    expect_error({"a", "-o"}, "-o", "needs a value");   // named as written, not by its long form
+    expect_error({"a", "--output"}, "--output", "needs a value");
+}
+
+TEST(Flags, ShortAliasWithEqualsSign) {
+    EXPECT_EQ(parse({"a", "-o=out.oct"}).value("--output"), "out.oct");
+}
+
+TEST(Flags, ListFlagsTakeOneValueEachInOrder) {
+    const Flags f({"in.oct", "--clip", "1,0,0,5", "mid", "--clip=-1,0,0,3", "--clip", "-1,2,3,4", "--iso", "-.5"},
+                  FlagSpec{{"--iso"}, {"--clip", "--colour"}, {}});
+    EXPECT_EQ(f.values("--clip"), (std::vector<std::string>{"1,0,0,5", "-1,0,0,3", "-1,2,3,4"}));
+    EXPECT_TRUE(f.values("--colour").empty());
+    EXPECT_EQ(f.value("--iso"), "-.5");
+    EXPECT_EQ(f.positional(), (std::vector<std::string>{"in.oct", "mid"}));
+    EXPECT_EQ(f.given(), (std::vector<std::string>{"--iso", "--clip"}));
+}
+
+TEST(AnswerHelp, HelpWinsAndNoArgumentsIsAUsageError) {
+    EXPECT_EQ(answer_help({"x", "--bogus", "-h"}, ""), 0);
+    EXPECT_EQ(answer_help({"x", "--help"}, ""), 0);
+    EXPECT_EQ(answer_help({}, ""), 2);
+    EXPECT_EQ(answer_help({"x", "--json"}, ""), std::nullopt);
 }
 
 }  // namespace
