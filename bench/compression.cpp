@@ -1,8 +1,15 @@
-// octiso-bench compression (issue 2, item 9): how small the lossless octree is, against the raw
-// array and against zstd -3 of the raw, how fast it builds and how much memory the build takes,
-// per dataset: the synthetic fields at --size N and the single-component MRI volumes of
+// octiso-bench compression (issue 2, item 9; issue 19): how small the lossless octree is, against
+// the raw array and against zstd -3 of the raw, where its bytes go (scalars, bounds, indices, caps)
+// in format 3 and in format 2 (the wide layout before issue 19, whose sizes follow exactly from the
+// same node and cap counts), how fast it builds and how much memory the build takes, per
+// dataset: the synthetic fields at --size N (ct-head at N x N x N/2), the real CT of
+// invesalius-examples (Cranium, i16) when installed, and the single-component MRI volumes of
 // mricron-data. Each conversion runs in its own octiso-convert process, so peak RSS is that one
 // conversion's; each .oct is extracted again with octiso-info and compared byte for byte.
+// --frames adds the frame time of octiso-render on each file (1 thread, 4 orbit frames at
+// 384^2, the minimum of 3 rounds); --baseline DIR renders the same data converted by the tools
+// in DIR (a build of an earlier commit, e.g. format 2) interleaved with ours, and checks that the
+// images are identical.
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -25,15 +32,28 @@ namespace fs = std::filesystem;
 
 constexpr const char* kUsage =
     "usage: octiso-bench compression [--size N] [--dataset NAME[,NAME...]] [--no-mri] [--mri-dir DIR]\n"
-    "                                [--threads N] [--markdown] [--results DIR]\n"
-    "  NAME: sphere marschner-lobb sierpinski noise plume mixing, 'mri', or an MRI file name (ch2.nii.gz)";
+    "                                [--threads N] [--frames] [--baseline DIR] [--markdown] [--results DIR]\n"
+    "  NAME: sphere marschner-lobb sierpinski noise plume mixing ct-head cranium, 'mri', or an MRI file name\n"
+    "        (ch2.nii.gz)\n"
+    "  --frames        also time octiso-render on each file (1 thread, 384^2, 4 frames, min of 3 rounds)\n"
+    "  --baseline DIR  also convert and render with the tools in DIR (an earlier build), interleaved";
 
-const std::vector<std::string> kSynthetic = {"sphere", "marschner-lobb", "sierpinski", "noise", "plume", "mixing"};
+const std::vector<std::string> kSynthetic = {"sphere", "marschner-lobb", "sierpinski", "noise", "plume", "mixing", "ct-head"};
+/// The real CT head of invesalius-examples: a tar of a raw int16 array, z slowest (main.plist).
+const char* kCraniumArchive = "/usr/share/doc/invesalius-examples/examples/Cranium.inv3";
+const Dims kCraniumDims{256, 256, 108};
 
 struct Dataset {
     std::string name;     // table label
     std::string source;   // synthetic spec NAME:N or the file path
     bool synthetic = true;
+    std::vector<std::string> raw_args;   // a raw file's --dims/--type
+};
+
+/// Frame time of one file: the median-free minimum over rounds of 4 orbit frames, per frame.
+struct FrameTime {
+    double seconds = 0;
+    bool measured = false;
 };
 
 struct Result {
@@ -41,6 +61,16 @@ struct Result {
     std::string type, dims;
     uint64_t voxels = 0, raw_bytes = 0, file_bytes = 0, interior_bytes = 0, minmax_bytes = 0, cap_bytes = 0;
     uint64_t zstd_bytes = 0, peak_rss = 0;
+    uint64_t interior_nodes = 0, caps = 0, scalar_bytes_size = 0;
+    double iso = 0;
+    FrameTime frame, baseline_frame;
+    uint64_t baseline_file_bytes = 0;
+    bool baseline_images_equal = false;
+    /// Format 2 (before issue 19): InteriorNode 24 s + 8 bytes, Cap 8 s bytes, same counts.
+    uint64_t format2_interior() const { return interior_nodes * (24 * scalar_bytes_size + 8); }
+    uint64_t format2_caps() const { return caps * 8 * scalar_bytes_size; }
+    uint64_t format2_minmax() const { return interior_nodes * 16 * scalar_bytes_size; }
+    double format2_percent() const { return 100.0 * double(format2_interior() + format2_caps()) / double(raw_bytes); }
     double build_seconds = 0, mvoxels_per_second = 0;   ///< the octree build alone (converter's clock)
     double total_seconds = 0;     ///< converter's clock from start to the renamed file (read + build + write)
     double process_seconds = 0;   ///< whole child process, fork to exit (libraries, reading, build, writing)
@@ -76,40 +106,119 @@ std::string mib(uint64_t b) { return fmt(double(b) / (1024.0 * 1024.0), 2); }
 
 /// Converts one dataset in a child process, extracts it again and compares; the reference voxels
 /// (generated here, or read through VTK exactly as the converter reads them) stay in this process.
-Result measure(const Dataset& set, const LoadedVolume& ref, const fs::path& tmp, int threads) {
+/// An isovalue inside the data: 40 % of the way up the range (+0.5 for integers, so that it
+/// never equals a stored value), the same for every layout.
+double iso_for(const std::string& json, bool integer) {
+    const size_t at = json.find("\"value_range\":[");
+    if (at == std::string::npos) return 0.5;
+    const char* p = json.c_str() + at + 15;
+    char* end = nullptr;
+    const double lo = std::strtod(p, &end);
+    const double hi = std::strtod(end + 1, nullptr);
+    const double v = lo + 0.4 * (hi - lo);
+    return integer ? std::floor(v) + 0.5 : v;
+}
+
+/// Per-frame seconds of octiso-render from `dir` on `oct` (4 orbit frames), writing PNGs to
+/// `png_pattern` (a %d field).
+double frame_seconds(const std::string& dir, const std::string& oct, double iso, const std::string& png_pattern) {
+    const std::string json = run_tool("octiso-render", {oct, "--iso", fmt(iso, 6), "-o", png_pattern, "--orbit", "4",
+                                                        "--threads", "1", "--size", "384x384", "--json"}, dir);
+    double total = 0;
+    for (size_t at = json.find("\"frame_seconds\":"); at != std::string::npos; at = json.find("\"frame_seconds\":", at + 1))
+        total += std::strtod(json.c_str() + at + 16, nullptr);
+    return total / 4;
+}
+
+bool same_files(const std::string& a, const std::string& b) {
+    std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+    const std::string x((std::istreambuf_iterator<char>(fa)), std::istreambuf_iterator<char>());
+    const std::string y((std::istreambuf_iterator<char>(fb)), std::istreambuf_iterator<char>());
+    return fa && fb && !x.empty() && x == y;
+}
+
+/// Converts one dataset in a child process, extracts it again and compares; the reference voxels
+/// (generated here, or read through VTK exactly as the converter reads them) stay in this process.
+Result measure(const Dataset& set, const LoadedVolume& ref, const fs::path& tmp, int threads, bool frames,
+               const std::optional<std::string>& baseline) {
     Result r;
     r.set = set;
     r.type = std::string(scalar_type_name(ref.type()));
     r.dims = dims_text(ref.dims());
     r.voxels = ref.dims().voxels();
     r.raw_bytes = ref.bytes();
+    r.scalar_bytes_size = scalar_type_bytes(ref.type());
 
     const std::string oct = (tmp / "dataset.oct").string(), raw = (tmp / "dataset.raw").string();
     std::vector<std::string> args;
     if (set.synthetic) args = {"--synthetic", set.source};
     else args = {set.source};
-    args.insert(args.end(), {"-o", oct, "--json", "--threads", std::to_string(threads)});
+    args.insert(args.end(), set.raw_args.begin(), set.raw_args.end());
+    std::vector<std::string> convert_args = args;
+    convert_args.insert(convert_args.end(), {"-o", oct, "--json", "--threads", std::to_string(threads)});
     const auto t0 = std::chrono::steady_clock::now();
-    const std::string json = run_tool("octiso-convert", args);
+    const std::string json = run_tool("octiso-convert", convert_args);
     r.process_seconds = seconds_since(t0);
     r.total_seconds = json_number(json, "total_seconds");
     r.file_bytes = uint64_t(json_number(json, "file_bytes"));
     r.interior_bytes = uint64_t(json_number(json, "interior_bytes"));
     r.minmax_bytes = uint64_t(json_number(json, "minmax_bytes"));
     r.cap_bytes = uint64_t(json_number(json, "cap_bytes"));
+    r.interior_nodes = uint64_t(json_number(json, "interior_node_count"));
+    r.caps = uint64_t(json_number(json, "cap_count"));
     r.build_seconds = json_number(json, "build_seconds");
     r.mvoxels_per_second = json_number(json, "mvoxels_per_second");
     r.peak_rss = uint64_t(json_number(json, "peak_rss_bytes"));
     r.threads = int(json_number(json, "threads"));
     if (uint64_t(json_number(json, "input_bytes")) != r.raw_bytes)
         throw Error(set.source, "converter and benchmark disagree on the input size", ErrorKind::Other);
+    const bool integer = ref.type() != ScalarType::f32 && ref.type() != ScalarType::f64;
+    r.iso = iso_for(json, integer);
 
     r.zstd_bytes = zstd_bytes(ref.data(), ref.bytes());
     // Synthetic and VTK volumes are native-endian, so the extracted bytes must equal ref's bytes.
     run_tool("octiso-info", {oct, "--extract-raw", raw});
     r.round_trip = !ref.swap_bytes() && file_equals(raw, ref.data(), ref.bytes());
-    fs::remove(oct);
     fs::remove(raw);
+
+    // Frame time, ours and the baseline's interleaved round by round (minimum per side).
+    if (frames || baseline) {
+        const std::string base_oct = (tmp / "baseline.oct").string();
+        if (baseline) {
+            // A synthetic field goes to the baseline as raw bytes (spacing 1, origin 0, as the
+            // generator places it): an earlier build may not know the generator.
+            std::vector<std::string> b = args;
+            const std::string dump = (tmp / "baseline.raw").string();
+            if (set.synthetic) {
+                std::ofstream(dump, std::ios::binary).write(reinterpret_cast<const char*>(ref.data()), std::streamsize(ref.bytes()));
+                const Dims d = ref.dims();
+                b = {dump, "--dims", std::to_string(d.x) + "," + std::to_string(d.y) + "," + std::to_string(d.z), "--type", r.type};
+            }
+            b.insert(b.end(), {"-o", base_oct, "--json", "--threads", std::to_string(threads)});
+            r.baseline_file_bytes = uint64_t(json_number(run_tool("octiso-convert", b, *baseline), "file_bytes"));
+            fs::remove(dump);
+        }
+        const std::string ours_png = (tmp / "ours_%d.png").string(), base_png = (tmp / "base_%d.png").string();
+        double best = 1e300, best_base = 1e300;
+        for (int round = 0; round < 3; ++round) {
+            best = std::min(best, frame_seconds(tools_dir(), oct, r.iso, ours_png));
+            if (baseline) best_base = std::min(best_base, frame_seconds(*baseline, base_oct, r.iso, base_png));
+        }
+        r.frame = {best, true};
+        if (baseline) {
+            r.baseline_frame = {best_base, true};
+            r.baseline_images_equal = true;
+            for (int k = 0; k < 4; ++k)
+                r.baseline_images_equal &= same_files((tmp / ("ours_" + std::to_string(k) + ".png")).string(),
+                                                      (tmp / ("base_" + std::to_string(k) + ".png")).string());
+        }
+        for (int k = 0; k < 4; ++k) {
+            fs::remove(tmp / ("ours_" + std::to_string(k) + ".png"));
+            fs::remove(tmp / ("base_" + std::to_string(k) + ".png"));
+        }
+        fs::remove(base_oct);
+    }
+    fs::remove(oct);
     return r;
 }
 
@@ -123,6 +232,17 @@ void write_results(cli::JsonWriter& j, const std::vector<Result>& results, int s
         j.field("type", r.type).field("dims", r.dims).field("voxels", r.voxels);
         j.field("raw_bytes", r.raw_bytes).field("file_bytes", r.file_bytes).field("percent_of_raw", r.percent());
         j.field("interior_bytes", r.interior_bytes).field("minmax_bytes", r.minmax_bytes).field("cap_bytes", r.cap_bytes);
+        j.field("interior_nodes", r.interior_nodes).field("caps", r.caps);
+        j.field("scalar_bytes", r.interior_nodes * 8 * r.scalar_bytes_size).field("index_bytes", r.interior_nodes * 8);
+        j.field("format2_interior_bytes", r.format2_interior()).field("format2_minmax_bytes", r.format2_minmax());
+        j.field("format2_cap_bytes", r.format2_caps()).field("format2_percent_of_raw", r.format2_percent());
+        j.field("iso", r.iso);
+        if (r.frame.measured) j.field("frame_seconds", r.frame.seconds);
+        if (r.baseline_frame.measured)
+            j.field("baseline_frame_seconds", r.baseline_frame.seconds)
+                .field("baseline_file_bytes", r.baseline_file_bytes)
+                .field("speedup_over_baseline", r.baseline_frame.seconds / r.frame.seconds)
+                .field("images_equal_to_baseline", r.baseline_images_equal);
         j.field("zstd3_bytes", r.zstd_bytes).field("zstd3_percent_of_raw", r.zstd_percent());
         j.field("build_seconds", r.build_seconds).field("mvoxels_per_second", r.mvoxels_per_second);
         j.field("convert_total_seconds", r.total_seconds).field("process_seconds", r.process_seconds);
@@ -159,6 +279,8 @@ int run_compression(cli::Args& args) {
     const bool no_mri = args.flag("--no-mri");
     const std::string mri_dir = args.value("--mri-dir").value_or("/usr/share/mricron/templates");
     const bool markdown = args.flag("--markdown");
+    const bool frames = args.flag("--frames");
+    const std::optional<std::string> baseline = args.value("--baseline");
     const std::string results = results_dir(args);
     args.finish();
 
@@ -171,15 +293,29 @@ int run_compression(cli::Args& args) {
     };
     std::vector<Dataset> sets;
     for (const std::string& name : kSynthetic)
-        if (is_wanted(name, false)) sets.push_back({name, name + ":" + std::to_string(size), true});
-    for (const std::string& path : mri_files(mri_dir)) {
-        const std::string name = fs::path(path).filename().string();
-        if (is_wanted(name, true)) sets.push_back({name, path, false});
-    }
-    if (sets.empty()) throw Error("--dataset", "selects no dataset\n" + std::string(kUsage));
-
+        if (is_wanted(name, false))
+            sets.push_back({name, name + ":" + (name == "ct-head" ? std::to_string(size) + "," + std::to_string(size) + "," +
+                                                                        std::to_string(std::max(2, size / 2))
+                                                                  : std::to_string(size)),
+                            true, {}});
     const fs::path tmp = fs::temp_directory_path() / ("octiso-bench-compression-" + std::to_string(::getpid()));
     fs::create_directories(tmp);
+    if (is_wanted("cranium", true) && fs::exists(kCraniumArchive)) {
+        // The archive holds matrix.dat: 256 x 256 x 108 int16, x fastest (numpy C order z, y, x).
+        const std::string out = (tmp / "cranium").string();
+        fs::create_directories(out);
+        const std::string cmd = "tar -xzf " + shell_quote(kCraniumArchive) + " -C " + shell_quote(out) + " --wildcards '*/matrix.dat'";
+        if (std::system(cmd.c_str()) != 0) throw Error(kCraniumArchive, "cannot unpack", ErrorKind::Other);
+        for (const auto& e : fs::recursive_directory_iterator(out))
+            if (e.path().filename() == "matrix.dat")
+                sets.push_back({"cranium (CT)", e.path().string(), false,
+                                {"--dims", "256,256,108", "--type", "i16"}});
+    }
+    for (const std::string& path : mri_files(mri_dir)) {
+        const std::string name = fs::path(path).filename().string();
+        if (is_wanted(name, true)) sets.push_back({name, path, false, {}});
+    }
+    if (sets.empty()) throw Error("--dataset", "selects no dataset\n" + std::string(kUsage));
     std::vector<Result> rows;
     std::vector<std::string> skipped;
     for (const Dataset& set : sets) {
@@ -188,6 +324,11 @@ int run_compression(cli::Args& args) {
             if (set.synthetic) {
                 const SyntheticSpec spec = parse_synthetic(set.source);
                 ref = synthetic_step(spec.name, spec.dims, 0);
+            } else if (!set.raw_args.empty()) {
+                RawOptions raw;
+                raw.dims = kCraniumDims;
+                raw.type = ScalarType::i16;
+                ref = open_volume(set.source, raw);
             } else {
                 ref = open_volume(set.source, RawOptions{});
             }
@@ -200,7 +341,7 @@ int run_compression(cli::Args& args) {
         }
         std::cerr << "converting " << set.name << " (" << scalar_type_name(ref->type()) << " " << dims_text(ref->dims())
                   << ") ...\n";
-        rows.push_back(measure(set, *ref, tmp, threads));
+        rows.push_back(measure(set, *ref, tmp, threads, frames, baseline));
     }
     fs::remove_all(tmp);
 
@@ -215,16 +356,36 @@ int run_compression(cli::Args& args) {
     std::cout << "octiso-bench compression: " << machine_description() << "\n";
     table.print(std::cout);
     if (markdown) table.print_markdown(std::cout);
+    // Where the bytes go, format 3 against format 2 (issue 19), and the frame time where measured.
+    Table parts({"dataset", "type", "nodes", "caps", "scalars MiB", "bounds MiB", "indices MiB", "caps MiB", "% raw",
+                 "format 2: min/max MiB", "caps MiB", "% raw", "zstd-3 % raw", "iso", "frame ms", "baseline ms", "speed-up",
+                 "same image"});
+    for (const Result& r : rows) {
+        const bool b = r.baseline_frame.measured;
+        parts.add({r.set.name, r.type, std::to_string(r.interior_nodes), std::to_string(r.caps),
+                   mib(r.interior_nodes * 8 * r.scalar_bytes_size), mib(r.minmax_bytes), mib(r.interior_nodes * 8),
+                   mib(r.cap_bytes), fmt(r.percent(), 1), mib(r.format2_minmax()), mib(r.format2_caps()),
+                   fmt(r.format2_percent(), 1), fmt(r.zstd_percent(), 1), fmt(r.iso, 6),
+                   r.frame.measured ? fmt(1e3 * r.frame.seconds, 1) : "-", b ? fmt(1e3 * r.baseline_frame.seconds, 1) : "-",
+                   b ? fmt(r.baseline_frame.seconds / r.frame.seconds, 3) : "-", b ? (r.baseline_images_equal ? "yes" : "NO") : "-"});
+    }
+    std::cout << "\nbytes by part (format 3) and format 2 from the same counts; frames: 1 thread, 384^2, min of 3 rounds\n";
+    parts.print(std::cout);
+    if (markdown) parts.print_markdown(std::cout);
     print_targets(std::cout, rows, size);
 
     std::string command = "octiso-bench compression --size " + std::to_string(size) + " --threads " + std::to_string(threads);
     if (only) command += " --dataset " + *only;
     if (no_mri) command += " --no-mri";
+    if (frames) command += " --frames";
+    if (baseline) command += " --baseline " + *baseline;
     const std::string name = size == 256 ? "compression" : "compression_" + std::to_string(size);
     const std::string json = write_json(results, name, [&](cli::JsonWriter& j) { write_results(j, rows, size, threads, command, skipped); });
     std::cerr << "results: " << json << "\n";
     plot("compression", json, results + "/" + name + ".png");
-    const bool all_exact = std::all_of(rows.begin(), rows.end(), [](const Result& r) { return r.round_trip; });
+    const bool all_exact = std::all_of(rows.begin(), rows.end(), [&](const Result& r) {
+        return r.round_trip && (!baseline || r.baseline_images_equal);
+    });
     return all_exact ? 0 : 1;
 }
 

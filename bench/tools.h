@@ -37,13 +37,14 @@ inline std::string shell_quote(const std::string& text) {
     return q + "'";
 }
 
-/// Runs TOOL (octiso-convert, octiso-info, ...) from tools_dir() with `args` (each quoted) and
+/// Runs TOOL (octiso-convert, octiso-info, ...) from `dir` (default tools_dir()) with `args` (each quoted) and
 /// returns its stdout. A non-zero exit throws Error(tool, its stderr) so a benchmark never
 /// reports numbers of a failed run.
-inline std::string run_tool(const std::string& tool, const std::vector<std::string>& args) {
+inline std::string run_tool(const std::string& tool, const std::vector<std::string>& args,
+                            const std::string& dir = tools_dir()) {
     const std::string err_path = std::filesystem::temp_directory_path() /
                                  ("octiso-bench-" + std::to_string(::getpid()) + ".stderr");
-    std::string cmd = shell_quote(tools_dir() + "/" + tool);
+    std::string cmd = shell_quote(dir + "/" + tool);
     for (const auto& a : args) cmd += " " + shell_quote(a);
     cmd += " 2>" + shell_quote(err_path);
     std::FILE* p = ::popen(cmd.c_str(), "r");

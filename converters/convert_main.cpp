@@ -191,6 +191,10 @@ void write_json(std::ostream& os, const ConvertReport& r, const std::optional<st
     else j.null();
     j.key("split").begin_object();
     j.field("interior_bytes", tot.interior_bytes).field("minmax_bytes", tot.minmax_bytes).field("cap_bytes", tot.cap_bytes);
+    uint64_t interior_nodes = 0;
+    for (size_t k = 0; k + 1 < tot.nodes_per_depth.size(); ++k) interior_nodes += tot.nodes_per_depth[k];
+    j.field("interior_node_count", interior_nodes)
+        .field("cap_count", tot.nodes_per_depth.empty() ? 0 : tot.nodes_per_depth.back());
     j.end_object();
     j.key("depths").begin_array();
     for (int k = 0; k < int(tot.nodes_per_depth.size()); ++k) {

@@ -6,6 +6,8 @@
 
 #if defined(__GNUC__)
 #define OCTISO_ALWAYS_INLINE [[gnu::always_inline]] inline
+#define OCTISO_LAMBDA_INLINE __attribute__((always_inline))   ///< after a lambda's parameter list
 #else
 #define OCTISO_ALWAYS_INLINE inline
+#define OCTISO_LAMBDA_INLINE
 #endif

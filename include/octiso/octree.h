@@ -72,9 +72,11 @@ inline constexpr uint64_t kCapReadSlack = 8;
 /// whose lower corner lies in child c (the one-voxel forward layer +x,+y,+z counts). With no
 /// such cell (pure padding or the last data layer) the bounds are empty and traversal skips the
 /// child. 1-byte scalars: the exact min/max. Wider ones: 8-bit codes inside [lo, hi], the exact
-/// range of the node's children together; code q stands for lo + q * step (step = (hi - lo) /
-/// 255 as lo + q * ((hi - lo) * (1/255)), 0 is lo and 255 is hi exactly), the packer picks the
-/// largest lower code and the smallest upper code that still contain the true range (it runs
+/// range of the node's children together, in steps of s = hi/255 - lo/255 (finite for every
+/// double range): a lower code q stands for lo + q s (0: lo exactly), an upper code q for
+/// hi - (255 - q) s (255: hi exactly). No branch and no select in the decode (the first version,
+/// 0 and 255 as special cases, cost packet_node 19 %, perf on Marschner-Lobb 256^3). The packer
+/// picks the largest lower and smallest upper code that still contain the true range (it runs
 /// this same decode), and qmin > qmax marks an empty child.
 template <typename T, bool kExact = (sizeof(T) == 1)> struct ChildBounds;
 
@@ -103,17 +105,16 @@ template <typename T> struct ChildBounds<T, false> {
     uint8_t qmin[8];
     uint8_t qmax[8];
     static constexpr int kTop = 255;
-    OCTISO_ALWAYS_INLINE double step() const { return (double(hi) - double(lo)) * (1.0 / kTop); }
-    OCTISO_ALWAYS_INLINE double decode(int q, double step) const {
-        return q == 0 ? double(lo) : q == kTop ? double(hi) : double(lo) + double(q) * step;
-    }
+    OCTISO_ALWAYS_INLINE double step() const { return double(hi) * (1.0 / kTop) - double(lo) * (1.0 / kTop); }
+    OCTISO_ALWAYS_INLINE double decode_lower(int q, double step) const { return double(lo) + double(q) * step; }
+    OCTISO_ALWAYS_INLINE double decode_upper(int q, double step) const { return double(hi) - double(kTop - q) * step; }
     OCTISO_ALWAYS_INLINE bool empty(int c) const { return qmin[c] > qmax[c]; }
-    OCTISO_ALWAYS_INLINE double lower(int c) const { return decode(qmin[c], step()); }
-    OCTISO_ALWAYS_INLINE double upper(int c) const { return decode(qmax[c], step()); }
+    OCTISO_ALWAYS_INLINE double lower(int c) const { return decode_lower(qmin[c], step()); }
+    OCTISO_ALWAYS_INLINE double upper(int c) const { return decode_upper(qmax[c], step()); }
     OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const {
         if (empty(c)) return false;
         const double s = step();
-        return decode(qmin[c], s) <= iso && iso <= decode(qmax[c], s);
+        return decode_lower(qmin[c], s) <= iso && iso <= decode_upper(qmax[c], s);
     }
     /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
     double range_lo() const {

@@ -44,15 +44,12 @@ template <typename T> ChildBounds<T> pack_bounds(const T (&mn)[8], const T (&mx)
                 return int(std::clamp(r, 0.0, double(top)));
             };
             int ql = guess(a, false), qh = guess(z, true);
-            while (ql > 0 && b.decode(ql, s) > a) --ql;
-            while (ql < top && b.decode(ql + 1, s) <= a) ++ql;
-            while (qh < top && b.decode(qh, s) < z) ++qh;
-            while (qh > 0 && b.decode(qh - 1, s) >= z) --qh;
-            if (ql > qh) {   // a plateau of the decode (lo == hi, or rounding): one code holds both ends
-                if (b.decode(qh, s) <= a) ql = qh;
-                else ql = 0, qh = top;
-            }
-            OCTISO_DCHECK(b.decode(ql, s) <= a && z <= b.decode(qh, s) && ql <= qh, "bounds code of child ", c);
+            while (ql > 0 && b.decode_lower(ql, s) > a) --ql;
+            while (ql < top && b.decode_lower(ql + 1, s) <= a) ++ql;
+            while (qh < top && b.decode_upper(qh, s) < z) ++qh;
+            while (qh > 0 && b.decode_upper(qh - 1, s) >= z) --qh;
+            if (ql > qh) ql = 0, qh = top;   // a plateau of the decode (lo == hi): the node's own range
+            OCTISO_DCHECK(b.decode_lower(ql, s) <= a && z <= b.decode_upper(qh, s) && ql <= qh, "bounds code of child ", c);
             b.qmin[c] = uint8_t(ql), b.qmax[c] = uint8_t(qh);
         }
     }
