@@ -241,7 +241,7 @@ private:
     /// neighbour finding on first use and then read directly. One per cap visit; a packet shares
     /// it between its lanes.
     struct CapBlocks {
-        CapRef<T> cap[8];     ///< blocks in a cap: read voxel by voxel (a whole decode cost 8-29 %)
+        CapRef<T> cap[8];     ///< blocks in a cap, read voxel by voxel (decoding each block whole: 0.82 x on Marschner-Lobb, BENCHMARKS issue 19)
         T value[8];           ///< blocks inside a scalar leaf
         unsigned located = 1;   ///< block 0 is the cap itself
         unsigned in_cap = 1;
