@@ -8,7 +8,8 @@ writes for the command the page offers ("copy command"): the raw RGBA frame the 
 loopback, then the same view asked again as PNG (the encoding used from another host; decoded by
 a small decoder below), and each time the page's canvas read back as it is on screen. Then the
 shadows toggle, once: the settled frame (the light kit with shadow rays) must equal octiso-render's
-image for the command the page then offers, which carries --shadows.
+image for the command the page then offers, which carries --shadows; and "save image" must download
+a PNG of exactly those pixels.
 
     tests/view/e2e_view.py TOOLS_DIR
 
@@ -209,6 +210,21 @@ def main():
         assert " --shadows " in shadowed["command"] and "--shading" not in shadowed["command"], shadowed["command"]
         shadow_ref = check(shadowed, "rgba")
         assert shadow_ref[3] != ref[3], "the shadows toggle did not change the frame"
+        # Save image: the PNG the page downloads holds the shown frame's pixels (the shadowed one),
+        # named after its isovalue.
+        driver.find_element(By.ID, "save").click()
+        wait.until(lambda d: d.execute_script("return window.octiso.lastSaved !== null"))
+        saved = driver.execute_async_script("""
+            const done = arguments[arguments.length - 1];
+            const s = window.octiso.lastSaved;
+            const reader = new FileReader();
+            reader.onload = () => done({name: s.name, png: reader.result.split(',')[1]});
+            reader.readAsDataURL(s.blob);""")
+        assert saved["name"].startswith(f"octiso_iso{iso_after}_") and saved["name"].endswith("_shadows.png"), saved["name"]
+        saved_w, saved_h, saved_rgb = decode_png(base64.b64decode(saved["png"]))
+        assert (saved_w, saved_h) == (shadow_ref[1], shadow_ref[2]), ((saved_w, saved_h), shadow_ref[1:3])
+        differing = sum(1 for i in range(0, len(saved_rgb), 3) if saved_rgb[i:i + 3] != shadow_ref[3][i:i + 3])
+        assert differing == 0, f"{differing} pixels of the saved image differ from octiso-render's"
         command, ref_w, ref_h, ref = ref
         background = ref[0:3]
         hit = sum(1 for i in range(0, len(ref), 3) if ref[i:i + 3] != background)
