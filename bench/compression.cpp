@@ -44,19 +44,18 @@ constexpr const char* kUsage =
 const std::vector<std::string> kSynthetic = {"sphere", "marschner-lobb", "sierpinski", "noise", "plume", "mixing", "ct-head"};
 /// The real CT head of invesalius-examples: a tar of a raw int16 array, z slowest (main.plist).
 const char* kCraniumArchive = "/usr/share/doc/invesalius-examples/examples/Cranium.inv3";
-const Dims kCraniumDims{256, 256, 108};
+const RawOptions kCranium = [] {
+    RawOptions o;
+    o.dims = Dims{256, 256, 108};
+    o.type = ScalarType::i16;
+    return o;
+}();
 
 struct Dataset {
     std::string name;     // table label
     std::string source;   // synthetic spec NAME:N or the file path
     bool synthetic = true;
-    std::vector<std::string> raw_args;   // a raw file's --dims/--type
-};
-
-/// Frame time of one file: the median-free minimum over rounds of 4 orbit frames, per frame.
-struct FrameTime {
-    double seconds = 0;
-    bool measured = false;
+    std::optional<RawOptions> raw;   // a raw file's grid and type (the converter's --dims/--type)
 };
 
 struct Result {
@@ -66,7 +65,8 @@ struct Result {
     uint64_t zstd_bytes = 0, peak_rss = 0;
     uint64_t interior_nodes = 0, caps = 0, scalar_bytes_size = 0;
     double iso = 0;
-    FrameTime frame, baseline_frame;
+    /// Seconds per frame: the minimum over rounds of the mean of 4 orbit frames (--frames).
+    std::optional<double> frame, baseline_frame;
     uint64_t baseline_file_bytes = 0;
     bool baseline_images_equal = false;
     /// Format 2 (before issue 19): InteriorNode 24 s + 8 bytes, Cap 8 s bytes, same counts.
@@ -185,7 +185,11 @@ Result measure(const Dataset& set, const LoadedVolume& ref, const fs::path& tmp,
     std::vector<std::string> args;
     if (set.synthetic) args = {"--synthetic", set.source};
     else args = {set.source};
-    args.insert(args.end(), set.raw_args.begin(), set.raw_args.end());
+    if (set.raw) {
+        const Dims d = *set.raw->dims;
+        args.insert(args.end(), {"--dims", std::to_string(d.x) + "," + std::to_string(d.y) + "," + std::to_string(d.z),
+                                 "--type", std::string(scalar_type_name(*set.raw->type))});
+    }
     std::vector<std::string> convert_args = args;
     convert_args.insert(convert_args.end(), {"-o", oct, "--json", "--threads", std::to_string(threads)});
     const auto t0 = std::chrono::steady_clock::now();
@@ -239,9 +243,9 @@ Result measure(const Dataset& set, const LoadedVolume& ref, const fs::path& tmp,
             best = std::min(best, frame_seconds(tools_dir(), oct, r.iso, ours_png));
             if (baseline) best_base = std::min(best_base, frame_seconds(*baseline, base_oct, r.iso, base_png));
         }
-        r.frame = {best, true};
+        r.frame = best;
         if (baseline) {
-            r.baseline_frame = {best_base, true};
+            r.baseline_frame = best_base;
             r.baseline_images_equal = true;
             for (int k = 0; k < 4; ++k)
                 r.baseline_images_equal &= same_files((tmp / ("ours_" + std::to_string(k) + ".png")).string(),
@@ -272,11 +276,11 @@ void write_results(cli::JsonWriter& j, const std::vector<Result>& results, int s
         j.field("format2_interior_bytes", r.format2_interior()).field("format2_minmax_bytes", r.format2_minmax());
         j.field("format2_cap_bytes", r.format2_caps()).field("format2_percent_of_raw", r.format2_percent());
         j.field("iso", r.iso);
-        if (r.frame.measured) j.field("frame_seconds", r.frame.seconds);
-        if (r.baseline_frame.measured)
-            j.field("baseline_frame_seconds", r.baseline_frame.seconds)
+        if (r.frame) j.field("frame_seconds", *r.frame);
+        if (r.baseline_frame)
+            j.field("baseline_frame_seconds", *r.baseline_frame)
                 .field("baseline_file_bytes", r.baseline_file_bytes)
-                .field("speedup_over_baseline", r.baseline_frame.seconds / r.frame.seconds)
+                .field("speedup_over_baseline", *r.baseline_frame / *r.frame)
                 .field("images_equal_to_baseline", r.baseline_images_equal);
         j.field("zstd3_bytes", r.zstd_bytes).field("zstd3_percent_of_raw", r.zstd_percent());
         j.field("build_seconds", r.build_seconds).field("mvoxels_per_second", r.mvoxels_per_second);
@@ -332,7 +336,7 @@ int run_compression(cli::Args& args) {
             sets.push_back({name, name + ":" + (name == "ct-head" ? std::to_string(size) + "," + std::to_string(size) + "," +
                                                                         std::to_string(std::max(2, size / 2))
                                                                   : std::to_string(size)),
-                            true, {}});
+                            true, std::nullopt});
     const fs::path tmp = fs::temp_directory_path() / ("octiso-bench-compression-" + std::to_string(::getpid()));
     fs::create_directories(tmp);
     if (is_wanted("cranium", true) && fs::exists(kCraniumArchive)) {
@@ -343,12 +347,11 @@ int run_compression(cli::Args& args) {
         if (std::system(cmd.c_str()) != 0) throw Error(kCraniumArchive, "cannot unpack", ErrorKind::Other);
         for (const auto& e : fs::recursive_directory_iterator(out))
             if (e.path().filename() == "matrix.dat")
-                sets.push_back({"cranium (CT)", e.path().string(), false,
-                                {"--dims", "256,256,108", "--type", "i16"}});
+                sets.push_back({"cranium (CT)", e.path().string(), false, kCranium});
     }
     for (const std::string& path : mri_files(mri_dir)) {
         const std::string name = fs::path(path).filename().string();
-        if (is_wanted(name, true)) sets.push_back({name, path, false, {}});
+        if (is_wanted(name, true)) sets.push_back({name, path, false, std::nullopt});
     }
     if (sets.empty()) throw Error("--dataset", "selects no dataset\n" + std::string(kUsage));
     std::vector<Result> rows;
@@ -359,13 +362,8 @@ int run_compression(cli::Args& args) {
             if (set.synthetic) {
                 const SyntheticSpec spec = parse_synthetic(set.source);
                 ref = synthetic_step(spec.name, spec.dims, 0);
-            } else if (!set.raw_args.empty()) {
-                RawOptions raw;
-                raw.dims = kCraniumDims;
-                raw.type = ScalarType::i16;
-                ref = open_volume(set.source, raw);
             } else {
-                ref = open_volume(set.source, RawOptions{});
+                ref = open_volume(set.source, set.raw.value_or(RawOptions{}));
             }
         } catch (const Error& e) {
             // Label maps with an RGB lookup, 4-D or multi-component files: the converter refuses
@@ -396,13 +394,13 @@ int run_compression(cli::Args& args) {
                  "format 2: min/max MiB", "caps MiB", "% raw", "zstd-3 % raw", "iso", "frame ms", "baseline ms", "speed-up",
                  "same image"});
     for (const Result& r : rows) {
-        const bool b = r.baseline_frame.measured;
+        const bool b = r.baseline_frame.has_value();
         parts.add({r.set.name, r.type, std::to_string(r.interior_nodes), std::to_string(r.caps),
                    mib(r.interior_nodes * 8 * r.scalar_bytes_size), mib(r.minmax_bytes), mib(r.interior_nodes * 8),
                    mib(r.cap_bytes), fmt(r.percent(), 1), mib(r.format2_minmax()), mib(r.format2_caps()),
                    fmt(r.format2_percent(), 1), fmt(r.zstd_percent(), 1), fmt(r.iso, 6),
-                   r.frame.measured ? fmt(1e3 * r.frame.seconds, 1) : "-", b ? fmt(1e3 * r.baseline_frame.seconds, 1) : "-",
-                   b ? fmt(r.baseline_frame.seconds / r.frame.seconds, 3) : "-", b ? (r.baseline_images_equal ? "yes" : "NO") : "-"});
+                   r.frame ? fmt(1e3 * *r.frame, 1) : "-", b ? fmt(1e3 * *r.baseline_frame, 1) : "-",
+                   b ? fmt(*r.baseline_frame / *r.frame, 3) : "-", b ? (r.baseline_images_equal ? "yes" : "NO") : "-"});
     }
     std::cout << "\nbytes by part (format 3) and format 2 from the same counts; frames: 1 thread, 384^2, min of 3 rounds\n";
     parts.print(std::cout);

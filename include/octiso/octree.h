@@ -57,8 +57,6 @@ template <typename T> struct ScalarKey {
 
 /// Bits of one voxel of a cap stored whole (no base, no deltas).
 template <typename T> inline constexpr unsigned kWholeCapBits = 8 * sizeof(T);
-/// Bytes of one cap record whose parent has `cap_bits`: 8 deltas of b bits are b bytes.
-template <typename T> constexpr uint64_t cap_record_bytes(unsigned cap_bits) { return cap_bits; }
 /// The widest delta a packed (not whole) cap may have: base + deltas must be smaller than the
 /// whole cap, and every delta must come out of one unaligned 64-bit load (shift <= 7).
 template <typename T> inline constexpr unsigned kMaxDeltaBits = 8 * sizeof(T) - 1 < 56 ? 8 * sizeof(T) - 1 : 56;
@@ -86,7 +84,6 @@ template <typename T> struct ChildBounds<T, true> {
     OCTISO_ALWAYS_INLINE bool empty(int c) const { return min[c] > max[c]; }
     OCTISO_ALWAYS_INLINE double lower(int c) const { return double(min[c]); }
     OCTISO_ALWAYS_INLINE double upper(int c) const { return double(max[c]); }
-    OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const { return double(min[c]) <= iso && iso <= double(max[c]); }
     /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
     double range_lo() const {
         double v = std::numeric_limits<double>::infinity();
@@ -111,11 +108,6 @@ template <typename T> struct ChildBounds<T, false> {
     OCTISO_ALWAYS_INLINE bool empty(int c) const { return qmin[c] > qmax[c]; }
     OCTISO_ALWAYS_INLINE double lower(int c) const { return decode_lower(qmin[c], step()); }
     OCTISO_ALWAYS_INLINE double upper(int c) const { return decode_upper(qmax[c], step()); }
-    OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const {
-        if (empty(c)) return false;
-        const double s = step();
-        return decode_lower(qmin[c], s) <= iso && iso <= decode_upper(qmax[c], s);
-    }
     /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
     double range_lo() const {
         for (int c = 0; c < 8; ++c) if (!empty(c)) return double(lo);
@@ -134,7 +126,8 @@ template <typename T> struct ChildBounds<T, false> {
 ///                           InteriorNode at index first_child() + rank(c) (rank: stored children
 ///                           before c) and scalar[c] is the midpoint of its data range. At depth
 ///                           dmax-2 it is a cap: its record starts at byte first_child() + rank(c)
-///                           * cap_record_bytes(cap_bits) of the caps, and scalar[c] is its base.
+///                           * cap_bits of the caps (8 deltas of b bits are b bytes), and scalar[c]
+///                           is its base.
 ///   bounds: ChildBounds above.
 /// The loader validates that the children of consecutive nodes follow each other exactly and
 /// stay inside the level below, and that cap_bits is kWholeCapBits or at most kMaxDeltaBits.
@@ -157,7 +150,11 @@ template <typename T> struct InteriorNode {
     OCTISO_ALWAYS_INLINE uint32_t child_index(int c) const { return child_start + rank(c); }
     /// Byte offset of cap child c among the caps (d == dmax-2).
     OCTISO_ALWAYS_INLINE uint64_t cap_offset(int c) const { return first_child() + uint64_t(rank(c)) * cap_bits; }
-    OCTISO_ALWAYS_INLINE bool may_contain(int c, double iso) const { return bounds.may_contain(c, iso); }
+    /// What the stored children take in the level below: nodes, or (`caps_below`, a cap parent)
+    /// bytes of caps. The builders and the validator place and check children by it.
+    uint64_t children_span(bool caps_below) const {
+        return uint64_t(std::popcount(unsigned(child_mask))) * (caps_below ? cap_bits : 1u);
+    }
     OCTISO_ALWAYS_INLINE bool may_contain_any(int c, const double* isos, int count) const {
         if (bounds.empty(c)) return false;
         const double lo = bounds.lower(c), hi = bounds.upper(c);
@@ -214,12 +211,10 @@ OCTISO_ALWAYS_INLINE int octant_of(Coord p, uint32_t child_bit) {
     return ((p.x & child_bit) ? 4 : 0) | ((p.y & child_bit) ? 2 : 0) | ((p.z & child_bit) ? 1 : 0);
 }
 
-/// Where point location ended: the value, the depth of the node that holds it, and whether it is
-/// a cap voxel (side 1; `cap` is then that cap) or a scalar leaf child of an interior node (side
-/// child_bit(depth)).
+/// Where point location ended: a cap voxel (`cap` is then that cap) or a scalar leaf child of an
+/// interior node.
 template <typename T> struct LeafRef {
     T value;            ///< a scalar leaf's value (in_cap: see voxel())
-    int depth;          ///< depth of the holding node (cap: dmax-1)
     bool in_cap;
     CapRef<T> cap;      ///< in_cap only
     int octant = 0;     ///< in_cap only: the voxel's octant in the cap
@@ -269,8 +264,8 @@ public:
         for (;;) {
             const InteriorNode<T>& n = a_.nodes[size_t(depth)][index];
             const int c = octant_of(p, child_bit(depth));
-            if (n.is_scalar_leaf(c)) return {n.scalar[c], depth, false, {}, 0};
-            if (depth == cap_parents_at) return {T{}, depth + 1, true, this->cap(n, c), octant_of(p, 1u)};
+            if (n.is_scalar_leaf(c)) return {n.scalar[c], false, {}, 0};
+            if (depth == cap_parents_at) return {T{}, true, this->cap(n, c), octant_of(p, 1u)};
             index = n.child_index(c);
             ++depth;
         }

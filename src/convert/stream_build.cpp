@@ -206,7 +206,7 @@ private:
         // childless node's child_start is then where its children would start (the same bytes).
         const bool caps_below = d + 1 == dmax_ - 1;   // then offsets and counts are bytes
         const uint64_t global = n.first_child() + base;
-        const uint64_t end = global + uint64_t(std::popcount(unsigned(n.child_mask))) * (caps_below ? n.cap_bits : 1u);
+        const uint64_t end = global + n.children_span(caps_below);
         if (end > (caps_below ? kMaxCapByteOffset : uint64_t(1) << 32))
             throw Error(options_.source_name, caps_below ? "octree too large: more than 2^48 bytes of caps"
                                                          : "octree too large: more than 2^32 nodes at depth " +

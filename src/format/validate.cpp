@@ -85,7 +85,7 @@ ChunkResult check_chunk(const InteriorNode<T>* nodes, uint64_t begin, uint64_t e
     for (uint64_t i = begin; i < end; ++i) {
         const InteriorNode<T>& n = nodes[i];
         const uint64_t pc = uint64_t(std::popcount(unsigned(n.child_mask)));
-        const uint64_t span = pc * (caps_below ? n.cap_bits : 1u);   // bytes of caps, or nodes
+        const uint64_t span = n.children_span(caps_below);   // bytes of caps, or nodes
         const uint64_t start = n.first_child();
         auto fail = [&](std::string problem) {
             r.bad_node = i;

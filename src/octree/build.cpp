@@ -145,7 +145,7 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
         for (auto* p : parts) {
             auto& v = p->nodes[size_t(d)];
             for (auto& n : v) {
-                const uint64_t span = uint64_t(std::popcount(unsigned(n.child_mask))) * (caps_below ? n.cap_bits : 1u);
+                const uint64_t span = n.children_span(caps_below);
                 const uint64_t global = n.first_child() + (d >= k ? child_offset : 0);
                 if (global + span > limit)
                     throw Error(options.source_name, caps_below ? "octree too large: more than 2^48 bytes of caps"

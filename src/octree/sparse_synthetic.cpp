@@ -100,8 +100,7 @@ public:
             const bool caps_below = d + 1 == dmax_ - 1;
             const uint64_t next = caps_below ? caps_.size() : nodes_[size_t(d + 1)].size();
             for (const InteriorNode<T>& n : nodes_[size_t(d)]) {
-                const uint64_t span = uint64_t(std::popcount(unsigned(n.child_mask))) * (caps_below ? n.cap_bits : 1u);
-                OCTISO_CHECK(n.first_child() + span <= next, "depth ", d, ": children from ", n.first_child(), " past ",
+                OCTISO_CHECK(n.first_child() + n.children_span(caps_below) <= next, "depth ", d, ": children from ", n.first_child(), " past ",
                              next, " at depth ", d + 1);
             }
         }
@@ -205,8 +204,10 @@ private:
     // The same rules as build_octree with tolerance 0 (summary.h); the tests compare the arrays
     // node for node.
     Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, const Cap<T>* caps = nullptr, int n_caps = 0) {
-        if (start > (d + 1 == dmax_ - 1 ? kMaxCapByteOffset : uint64_t(std::numeric_limits<uint32_t>::max())))
-            throw Error("sparse-spheres", "octree too large: more than 2^32 nodes at depth " + std::to_string(d + 1));
+        const bool caps_below = d + 1 == dmax_ - 1;
+        if (start > (caps_below ? kMaxCapByteOffset : uint64_t(std::numeric_limits<uint32_t>::max())))
+            throw Error("sparse-spheres", caps_below ? "octree too large: more than 2^48 bytes of caps"
+                                                     : "octree too large: more than 2^32 nodes at depth " + std::to_string(d + 1));
         Summary<T> out;
         InteriorNode<T> n;
         if (detail::fold_children(d, ch, start, &SparseBuilder::mergeable, out, n)) return out;
