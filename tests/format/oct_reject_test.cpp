@@ -441,6 +441,30 @@ TEST(OctReject, BadHeaderFieldsAreErrors) {
     header_edit("flipped-axes mask", [](FileHeader& h) { h.flipped_axes = 8; });
 }
 
+/// f32 bounds must be finite: a NaN range would decode to bounds no isovalue compares with.
+TEST(OctReject, NonFiniteFloatBoundsAreErrors) {
+    ScratchDir dir;
+    const std::string good = dir.file("good.oct"), bad = dir.file("bad.oct");
+    const auto v = make_volume<float>({9, 6, 5}, Pattern::Random, 5);
+    write_oct<float>(good, info_for(ScalarType::f32, v.dims), {build_octree(v.view(), {}).view()});
+    for (const float lo : {std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::infinity()}) {
+        OctBytes b(good);
+        auto n = b.node<float>(0, 0, 0);
+        n.bounds.lo = lo;
+        b.set_node(0, 0, 0, n);
+        b.rechecksum();
+        b.save(bad);
+        for (Verify verify : {Verify::Full, Verify::IndicesOnly}) {
+            try {
+                load_everything(bad, verify);
+                ADD_FAILURE() << "bounds lo " << lo << " accepted";
+            } catch (const Error& e) {
+                EXPECT_NE(std::string(e.what()).find("bounds range is not finite and ordered"), std::string::npos) << e.what();
+            }
+        }
+    }
+}
+
 /// A valid small file relabelled as format `version` must be refused with exit status 2, naming
 /// the version and saying how to get a file this build reads.
 void expect_version_refused(uint32_t version) {
