@@ -124,7 +124,8 @@ template <typename T> struct ChildBounds<T, false> {
 ///                           (padding beyond the data excepted: it is "don't care").
 ///   child_mask bit c set:   child c is stored at depth d+1. Below depth dmax-2 it is the
 ///                           InteriorNode at index first_child() + rank(c) (rank: stored children
-///                           before c) and scalar[c] is the midpoint of its data range. At depth
+///                           before c) and scalar[c] is the voxel at its lower corner (format 4:
+///                           the level-of-detail lattice sample, see lattice_value). At depth
 ///                           dmax-2 it is a cap: its record starts at byte first_child() + rank(c)
 ///                           * cap_bits of the caps (8 deltas of b bits are b bytes), and scalar[c]
 ///                           is its base.
@@ -291,6 +292,35 @@ public:
                 return locate_from(dest, d, parent_trace[d]);
         }
         return locate_from(dest, 0, 0);
+    }
+
+    /// Level of detail (issue 14): the voxel at `q` where q is a multiple of `unit` (a power of
+    /// two), read without descending below the node whose lower corner q is: a stored child of
+    /// side <= unit keeps that voxel in its parent's scalar (format 4), a cap yields it from its
+    /// record, a scalar leaf holds it outright. So a coarse lattice of spacing `unit` touches
+    /// only the levels above it. `start`, `depth`, `parent_trace` as for neighbour_locate.
+    OCTISO_ALWAYS_INLINE T lattice_value(Coord start, Coord q, uint32_t unit, int depth, const uint32_t* parent_trace) const {
+        int d = 0;
+        uint32_t index = 0;
+        for (int k = depth; k > 0; --k) {
+            const int shift = a_.dmax - k;
+            if (((start.x ^ q.x) >> shift) == 0 && ((start.y ^ q.y) >> shift) == 0 && ((start.z ^ q.z) >> shift) == 0) {
+                d = k;
+                index = parent_trace[k];
+                break;
+            }
+        }
+        const int cap_parents_at = a_.dmax - 2;
+        for (;;) {
+            const InteriorNode<T>& n = a_.nodes[size_t(d)][index];
+            const uint32_t half = child_bit(d);
+            const int c = octant_of(q, half);
+            if (n.is_scalar_leaf(c)) return n.scalar[c];
+            if (d == cap_parents_at) return this->cap(n, c).voxel(octant_of(q, 1u));
+            if (half <= unit) return n.scalar[c];   // q is this child's lower corner
+            index = n.child_index(c);
+            ++d;
+        }
     }
 
 private:

@@ -152,6 +152,9 @@ void OctFile::Impl::check_header() {
     if (h.version == 2)
         fail("is .oct format version 2, the node layout before compact nodes and packed caps (format 3): convert "
              "the source again with octiso-convert");
+    if (h.version == 3)
+        fail("is .oct format version 3, whose stored children hold the midpoint of their range, not the corner "
+             "voxel level of detail samples (format 4): convert the source again with octiso-convert");
     if (h.version != format::kFormatVersion)
         fail("unsupported format version (expected " + num(format::kFormatVersion) + ", found " + num(h.version) + ")");
     if (h.header_bytes != sizeof(FileHeader))

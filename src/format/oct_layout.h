@@ -41,7 +41,7 @@
 //  with the table. So every byte of the file is covered by a checksum or must be zero, and a
 //  single flipped bit anywhere is detected (Verify::Full).
 //
-//  InteriorNode<T> record (format 3, issue 19; s = sizeof(T)), no padding:
+//  InteriorNode<T> record (formats 3 and 4, issue 19; s = sizeof(T)), no padding:
 //    +-------------+----------------+------------+----------+-----------+------------------------+
 //    | child_start | child_start_hi | child_mask | cap_bits | scalar[8] | bounds                 |
 //    | u32         | u16            | u8         | u8       | 8 T       | s == 1: min[8], max[8] |
@@ -68,7 +68,10 @@ inline constexpr char kMagic[8] = {'O', 'C', 'T', 'I', 'S', 'O', '\0', '\x1a'};
 /// axes, issue 17). Version 1 files are refused: they may hold NIfTI data stored unscaled.
 /// 3: the compact node layout and packed caps (issue 19). Version 2 files are refused with a
 /// message to convert again (their records are not this layout).
-inline constexpr uint32_t kFormatVersion = 3;
+/// 4: a stored interior child's scalar is the voxel at its lower corner, the level-of-detail
+/// lattice sample (issue 14), where format 3 kept the midpoint of its range; same layout, and
+/// version 3 files are refused with a message to convert again (`--lod` would misread them).
+inline constexpr uint32_t kFormatVersion = 4;
 inline constexpr uint32_t kEndianTag = 0x01020304u;   ///< reads back as 0x04030201 if swapped
 inline constexpr uint64_t kSectionAlign = 64;
 

@@ -57,8 +57,8 @@ struct ChunkResult {
 
 constexpr uint64_t kChunk = 1u << 15;
 
-/// The node's own fields (format 3, octree.h): the cap width where caps lie below, zero high
-/// offset bits and zero width elsewhere, ordered finite bounds. Empty when they are fine.
+/// The node's own fields (formats 3 and 4, octree.h): the cap width where caps lie below, zero high
+/// offset bits and zero width elsewhere, ordered finite bounds, lattice samples inside their ranges. Empty when they are fine.
 template <typename T> std::string field_problem(const InteriorNode<T>& n, bool caps_below) {
     if (caps_below) {
         if (n.cap_bits != kWholeCapBits<T> && n.cap_bits > kMaxDeltaBits<T>)
@@ -74,6 +74,18 @@ template <typename T> std::string field_problem(const InteriorNode<T>& n, bool c
             return "bounds range is not finite and ordered (found lo " + std::to_string(lo) + ", hi " +
                    std::to_string(hi) + ")";
     }
+    // Format 4: a stored interior child's scalar is the voxel at its lower corner, a corner of
+    // one of its data cells, so it lies in the child's range whenever that range is not empty.
+    // Level of detail traces it; outside the range it would draw a surface the culling denies.
+    if (!caps_below)
+        for (int c = 0; c < 8; ++c) {
+            if (!((n.child_mask >> c) & 1u) || n.bounds.empty(c)) continue;
+            const double v = double(n.scalar[c]);
+            if (!(n.bounds.lower(c) <= v && v <= n.bounds.upper(c)))
+                return "child " + std::to_string(c) + ": its lattice sample (scalar) lies outside its range (expected " +
+                       std::to_string(n.bounds.lower(c)) + " .. " + std::to_string(n.bounds.upper(c)) + ", found " +
+                       std::to_string(v) + ")";
+        }
     return {};
 }
 

@@ -85,12 +85,14 @@ template <typename T> struct Walker {
                                      std::to_string(vmax) + "]");
             }
             if (node.is_scalar_leaf(c) || d + 1 == tree.cap_depth()) continue;   // a cap's scalar is its base
-            // An interior child's scalar is the midpoint of its range: inside the stored range.
-            const double s = double(node.scalar[c]);
-            if (has_cells && std::isfinite(s) && !node.bounds.empty(c) &&
-                !(node.bounds.lower(c) <= s && s <= node.bounds.upper(c)))
-                lie(d, i, c, "scalar " + std::to_string(s) + " lies outside its range [" +
-                                 std::to_string(node.bounds.lower(c)) + ", " + std::to_string(node.bounds.upper(c)) + "]");
+            // An interior child's scalar is the voxel at its lower corner (format 4, the level-of-
+            // detail sample), bit for bit; a child with no data voxel keeps any value.
+            if (lo[0] < info.dims.x && lo[1] < info.dims.y && lo[2] < info.dims.z) {
+                const T want = at(lo[0], lo[1], lo[2]);
+                if (ScalarKey<T>::of(node.scalar[c]) != ScalarKey<T>::of(want))
+                    lie(d, i, c, "scalar " + std::to_string(double(node.scalar[c])) + " is not the voxel at its corner (" +
+                                     std::to_string(double(want)) + ")");
+            }
             walk(d + 1, node.child_index(c), lo);
         }
     }

@@ -1,6 +1,6 @@
 // build_sparse_octree: the top-down twin of build.cpp for an analytic sparse field. It follows
 // the builder's rules exactly (DFS post-order appends, leaf merging with tolerance 0, cap parents
-// from their 5^3 clamped neighbourhood, midpoint scalars, padding summaries), so the arrays are
+// from their 5^3 clamped neighbourhood, corner-voxel scalars, padding summaries), so the arrays are
 // the ones build_octree would produce from the dense grid. The one addition: a node whose own
 // voxels miss every blob support is uniform, so it is a leaf without descending; its cell range
 // is the background plus the blob values on its forward layer, enumerated from the supports.

@@ -18,7 +18,8 @@ namespace octiso::detail {
 
 /// What a finished subtree tells its parent.
 template <typename T> struct Summary {
-    T scalar;              ///< the value of a leaf; the midpoint of the data range otherwise
+    T scalar;              ///< the value of a leaf; otherwise the voxel at the subtree's lower corner
+                           ///< (format 4: the level-of-detail lattice sample, octree.h)
     T cell_min, cell_max;  ///< range over the data cells with lower corner inside; empty: min > max
     T data_lo, data_hi;    ///< range of the data voxels inside (meaningless when is_padding)
     bool is_leaf;
@@ -28,8 +29,6 @@ template <typename T> struct Summary {
         return {T{}, std::numeric_limits<T>::max(), std::numeric_limits<T>::lowest(), T{}, T{}, true, true};
     }
 };
-
-template <typename T> T midpoint(T lo, T hi) { return T(double(lo) + (double(hi) - double(lo)) / 2); }
 
 inline Coord child_origin(Coord o, int c, uint32_t half) {
     return {o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
@@ -81,7 +80,8 @@ bool fold_children(int d, const Summary<T>* ch, uint64_t start, const Mergeable&
     node.child_mask = mask;
     node.bounds = pack_bounds(mn, mx);
     node.set_first_child(start);   // local; the caller offsets and range-checks it
-    out = {any_data ? midpoint(lo, hi) : T{}, cmin, cmax, lo, hi, false, !any_data};
+    // The lower corner voxel lies in child 0, which holds data whenever the node does.
+    out = {any_data ? ch[0].scalar : T{}, cmin, cmax, lo, hi, false, !any_data};
     return false;
 }
 
@@ -158,7 +158,7 @@ void cap_parent_children(const T (&L)[5][5][5], Coord o, Dims dims, const Mergea
         Cap<T> cap;
         for (int k = 0; k < 8; ++k) cap.voxel[k] = L[bz + (k & 1)][by + ((k >> 1) & 1)][bx + ((k >> 2) & 1)];
         emit_cap(cap);
-        ch[c] = {midpoint(lo, hi), cmin, cmax, lo, hi, false, false};
+        ch[c] = {cap.voxel[0], cmin, cmax, lo, hi, false, false};   // its corner; pack_caps stores the base
     }
 }
 

@@ -245,6 +245,13 @@ TEST(OctReject, CompactNodeFieldsAreValidated) {
         b.set_node(0, 0, 0, n);
     }, "bounds range is not finite and ordered");
     expect([&](OctBytes& b) {
+        // Format 4: the root's stored child 0 keeps the voxel at (0, 0, 0), inside its range.
+        auto n = b.node<uint16_t>(0, 0, 0);
+        ASSERT_TRUE(n.child_mask & 1u);
+        n.scalar[0] = n.bounds.upper(0) < 65535 ? uint16_t(n.bounds.upper(0) + 1) : uint16_t(n.bounds.lower(0) - 1);
+        b.set_node(0, 0, 0, n);
+    }, "child 0: its lattice sample (scalar) lies outside its range");
+    expect([&](OctBytes& b) {
         const SectionEntry s = b.entry(b.entry_index(0, dmax - 1));
         b.bytes[s.offset + s.bytes - 1] = 1;   // the read slack after the last cap
     }, "bytes after the last cap are not zero");
@@ -498,6 +505,12 @@ TEST(OctReject, VersionOneFilesAskToBeConvertedAgain) {
 TEST(OctReject, VersionTwoFilesAskToBeConvertedAgain) {
     // Version 2 stored wide nodes and whole caps: nothing in it reads as format 3.
     expect_version_refused(2);
+}
+
+TEST(OctReject, VersionThreeFilesAskToBeConvertedAgain) {
+    // Version 3 has this layout but midpoints where level of detail reads corner voxels: read as
+    // format 4 it would render a wrong coarse surface without any error.
+    expect_version_refused(3);
 }
 
 TEST(OctReject, NonFilesAndEmptyFilesAreErrors) {

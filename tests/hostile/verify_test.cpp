@@ -73,7 +73,7 @@ TEST(HostileVerify, OneNarrowedRangeOrMisplacedScalarIsReported) {
     ASSERT_EQ(run_shell("'" + kTools + "/octiso-convert' --synthetic noise:32 --type u8 -o '" + good + "' 2>/dev/null"), 0);
     const OctBytes original(good);
     const int d = original.header().dmax - 2;   // the deepest interior level
-    const int above = d - 1;                    // its children are nodes: their scalar is a midpoint
+    const int above = d - 1;                    // its children are nodes: their scalar is their corner voxel
     bool narrowed = false, moved = false;
     for (uint64_t i = 0; i < original.entry(original.entry_index(0, d)).count && !narrowed; ++i)
         for (int c = 0; c < 8; ++c) {
