@@ -2,6 +2,7 @@
 // and what rendering it cost. Row 0 is the top row; pixel (x, y) is element y * width + x.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -11,6 +12,9 @@ struct RenderStats {
     double seconds = 0;                 ///< wall time of the tile loop
     uint64_t rays = 0, hits = 0;
     int threads = 0;
+    /// Hits by the side of the cell they lie in: hits_by_cell_log2[k] counts cells of 2^k voxels
+    /// (k = 0: full resolution; more only with level of detail, RenderOptions::lod).
+    std::array<uint64_t, 32> hits_by_cell_log2{};
     double mrays_per_second() const { return seconds > 0 ? double(rays) / seconds * 1e-6 : 0; }
 };
 

@@ -72,6 +72,13 @@ struct RenderOptions {
     /// Every ray's interval is cut to the intersection of these half-spaces before traversal
     /// (src/render/clip.h); empty: no clipping, the frames of before bit for bit.
     std::vector<ClipPlane> clip_planes;
+    /// Level of detail (issue 14, `--lod F`): 0 (the default) traces every surface at full
+    /// resolution; F > 0 stops descending where a node's cells would be no wider than F pixels at
+    /// its nearest point to the camera, and traces the trilinear field of the voxels on that
+    /// node's coarse lattice instead (src/render/lod.h). Below two voxels per F pixels nothing
+    /// changes: close up the frame is the exact one bit for bit. A Renderer with lod > 0 renders
+    /// its frames one at a time (the cut belongs to the camera); not with owned_cells.
+    double lod = 0;
 };
 
 /// What the renderer must know about the octree's source beyond its voxels: a file converted

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 
 #include <tbb/task_arena.h>
 
@@ -50,16 +51,18 @@ void validate_look(const Look& look, size_t iso_count, ShadingModel model) {
 }
 
 struct LookShader::Impl {
+    Impl(const AnyOctree& t, const RenderOptions& o, const Look& l) : tree(t), options(o), look(l) {}
     AnyOctree tree;
     RenderOptions options;
     Look look;
     TracerKernel kernel;
     double voxel = 1;
     std::unique_ptr<tbb::task_arena> arena;   ///< only when options.threads > 0, as the Renderer's
+    std::mutex lod_mutex;                     ///< held while a frame with level of detail is shaded (the cut is the camera's)
 };
 
 LookShader::LookShader(const AnyOctree& tree, const RenderOptions& options, const Look& look, ShadingModel model)
-    : impl_(std::make_unique<Impl>(Impl{tree, options, look, {}, 1, nullptr})) {
+    : impl_(std::make_unique<Impl>(tree, options, look)) {
     validate_options(options, tree.render_limits());
     validate_look(look, options.isovalues.size(), model);
     dispatch_scalar_type(tree.type(), [&](auto zero) {
@@ -93,7 +96,13 @@ struct BlockPixel {
 }  // namespace
 
 LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame& frame) const {
-    const Impl& m = *impl_;
+    Impl& m = *impl_;
+    // Level of detail: secondary rays see the primary rays' coarse surface, the same cut.
+    std::unique_lock<std::mutex> lod_turn;
+    if (m.options.lod > 0) {
+        lod_turn = std::unique_lock<std::mutex>(m.lod_mutex);
+        m.kernel.set_lod(m.kernel.user, make_lod_cut(camera, m.tree.placement(), m.options.lod));
+    }
     const size_t pixels = size_t(frame.width) * size_t(frame.height);
     if (frame.depth.size() != pixels || frame.normal.size() != 3 * pixels || frame.width != camera.width || frame.height != camera.height)
         throw Error("LookShader::shade", "needs the depth and normal AOVs of the frame", ErrorKind::Other);

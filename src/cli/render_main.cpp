@@ -70,6 +70,9 @@ const char* kUsage =
     "  --fov DEG                 vertical field of view (default 35)\n"
     "  --size WxH                image size in pixels (default 512x512)\n"
     "  --spp N                   samples per pixel, 1..256 (default 1); > 1 antialiases\n"
+    "  --lod F                   level of detail: stop where a node's cells are at most F pixels wide at its\n"
+    "                            nearest point and trace its coarse lattice (default 0: full resolution;\n"
+    "                            close up, below 2 voxels per F pixels, the image is the exact one)\n"
     "Look:\n"
     "  --shading kit|headlight   kit: a key and a fill light fixed to the camera, a little specular (default);\n"
     "                            headlight: Lambert from the eye plus ambient (the images before issue 17)\n"
@@ -95,7 +98,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     // --help (stdout, 0) and no argument (stderr, 2) as in every tool; under mpirun one rank prints.
     const std::string usage = std::string(kUsage) + cli::kLookUsage;
     if (const auto status = cli::answer_help(argv, ranks.rank == 0 ? usage : std::string())) return *status;
-    cli::FlagSpec spec{{"-o,--output", "--iso", "--steps", "--depth", "--normal", "--threads", "--root-finder", "--iterations", "--spp",
+    cli::FlagSpec spec{{"-o,--output", "--iso", "--steps", "--depth", "--normal", "--threads", "--root-finder", "--iterations", "--spp", "--lod",
                         "--shading", "--background", "--traversal", "--isa", "--debug-pixel", "--distribute"},
                        {"--colour"},
                        {"--no-embree", "--json", "--progress"}};
@@ -108,7 +111,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     const auto steps = args.value("--steps"), depth_path = args.value("--depth");
     const auto normal_path = args.value("--normal"), threads = args.value("--threads");
     const auto root_finder = args.value("--root-finder"), iterations = args.value("--iterations");
-    const auto spp_text = args.value("--spp");
+    const auto spp_text = args.value("--spp"), lod_text = args.value("--lod");
     const auto shading_text = args.value("--shading"), background_text = args.value("--background");
     const std::vector<std::string>& colour_texts = args.values("--colour");
     const bool no_embree = args.flag("--no-embree"), json = args.flag("--json"), progress_forced = args.flag("--progress");
@@ -151,6 +154,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     if (threads) options.threads = int(cli::parse_int(*threads, "--threads", 0, 4096));   // 0: all cores
     if (root_finder) options.root_finder = parse_root_finder_name(*root_finder);
     if (iterations) options.iterations = int(cli::parse_int(*iterations, "--iterations", 0, 1000));
+    if (lod_text) options.lod = cli::parse_double(*lod_text, "--lod");
+    if (lod_text && distribute_text && *distribute_text == "data")
+        throw Error("--lod", "level of detail is not available with --distribute data (each rank's cut would differ)");
     const int spp = spp_text ? int(cli::parse_int(*spp_text, "--spp", 1, kMaxSamplesPerPixel)) : 1;
     Shading shading;
     if (shading_text) {
@@ -358,6 +364,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                 record.bytes_sent += cost.bytes_sent;
             }
             record.rays += stats.rays;
+            for (size_t k = 0; k < stats.hits_by_cell_log2.size(); ++k) record.hits_by_cell_log2[k] += stats.hits_by_cell_log2[k];
             record.seconds += stats.seconds;
             record.threads = stats.threads;
             return stats;
@@ -421,6 +428,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         j.field("root_finder", std::string(root_finder ? *root_finder : "neubauer")).field("embree", options.use_embree);
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
+        j.field("lod", options.lod);
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
         cli::write_look_json(j, look_flags);   // issue 17 item 7
         j.field("ranks", rank_count).field("distribute", std::string(distribute_name(distribute)));
@@ -433,6 +441,12 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             j.field("seconds", r.seconds).field("frame_seconds", r.frame_seconds);
             j.field("mrays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0.0).field("rays", r.rays);
             j.field("hits", r.hits).field("threads", r.threads);
+            if (options.lod > 0) {   // issue 14: hits by the depth whose cells they lie in (dmax: full resolution)
+                j.key("hit_depths").begin_object();
+                for (size_t k = 0; k < r.hits_by_cell_log2.size(); ++k)
+                    if (r.hits_by_cell_log2[k]) j.field(std::to_string(info.dmax - int(k)), r.hits_by_cell_log2[k]);
+                j.end_object();
+            }
             if (rank_count > 1) j.field("rank", r.rank);
             if (out_path) j.field("image", name_for(out_path, "-o", r.index));
             if (look.active()) cli::write_look_stats_json(j, r.look);

@@ -32,6 +32,7 @@ struct FrameRecord {
     int rank = 0;
     double seconds = 0, frame_seconds = 0, exchange_seconds = 0, rank_wall_seconds = 0;
     uint64_t rays = 0, hits = 0, bytes_sent = 0;
+    std::array<uint64_t, 32> hits_by_cell_log2{};   ///< RenderStats::hits_by_cell_log2, summed over samples
     uint64_t file_resident_bytes = 0;   ///< of the rank's mapping of the .oct after its frames (smaps)
     int threads = 0;
     LookStats look;       ///< secondary rays of the look pass (issue 17 item 7)

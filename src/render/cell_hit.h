@@ -111,5 +111,46 @@ inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, Ray
     return true;
 }
 
+/// Level of detail (lod.h): intersect_cell on the coarse cell with lower corner v and sides
+/// `extent` (the lattice unit, cut to the data's last voxel on the upper border), corners at its
+/// 8 vertices. The segment is mapped into the unit cube by dividing by the extent, and the
+/// normal's gradient is per world unit through spacing x extent. A separate function so that the
+/// exact path keeps its arithmetic bit for bit.
+template <class Finder>
+inline bool intersect_coarse_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
+                                  const uint32_t extent[3], const double corner[8], double t_in, double t_out,
+                                  bool closed_end) {
+    double lo = corner[0], hi = corner[0];
+    for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
+    if (!scene.any_iso_in(lo, hi)) return false;
+    const IndexRay& r = w.ray;
+    const double base[3] = {double(v.x), double(v.y), double(v.z)};
+    std::array<double, 3> p_in, p_out, cell_spacing;
+    for (int a = 0; a < 3; ++a) {
+        const double e = double(extent[a]);
+        const double o = r.origin[a] - base[a];
+        p_in[a] = snap_to_face((o + t_in * r.dir[a]) / e);
+        p_out[a] = snap_to_face((o + t_out * r.dir[a]) / e);
+        cell_spacing[a] = scene.placement.spacing[a] * e;
+    }
+    double best_s = 2.0;
+    int best = -1;
+    for (int i = 0; i < scene.iso_count; ++i) {
+        const double iso = scene.isovalues[i];
+        if (!(lo <= iso && iso <= hi)) continue;
+        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end);
+        if (s >= 0 && s < best_s) best_s = s, best = i;
+    }
+    if (best < 0) return false;
+    w.hit.t = t_in + best_s * (t_out - t_in);
+    w.hit.iso_index = best;
+    if (w.want_normal) {
+        std::array<double, 3> p_hit;
+        for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + best_s * (p_out[a] - p_in[a]);
+        w.hit.normal = world_normal(corner, p_hit, cell_spacing, w.world_dir);
+    }
+    return true;
+}
+
 OCTISO_ISA_END
 }  // namespace octiso

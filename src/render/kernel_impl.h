@@ -33,6 +33,7 @@ template <typename T> TracerKernel build_tracer_kernel(const Octree<T>& tree, co
             k.trace = [](const void* user, const Ray& ray, bool normal) {
                 return static_cast<const Tracer*>(user)->trace(ray, normal);
             };
+            k.set_lod = [](const void* user, const LodCut& cut) { static_cast<const Tracer*>(user)->set_lod(cut); };
             k.trace_packet = [](const void* user, const Ray* rays, int count, const int* valid, bool normal, TraceHit* hits) {
                 static_cast<const Tracer*>(user)->trace_packet(rays, count, valid, normal, hits);
             };

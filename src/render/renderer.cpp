@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <mutex>
 
 #include <tbb/task_arena.h>
 
@@ -38,6 +39,10 @@ void validate_options(const RenderOptions& options, const RenderLimits& limits) 
                                          "): the data there was clamped when " + limits.source + " was converted");
     }
     if (options.tile_size < 0) throw Error("tile_size", "must not be negative");
+    if (!(std::isfinite(options.lod) && options.lod >= 0))
+        throw Error("--lod", "expected a finite factor >= 0 (0: full resolution)");
+    if (options.lod > 0 && options.owned_cells)
+        throw Error("--lod", "level of detail is not available with --distribute data (each rank's cut would differ)");
     for (const ClipPlane& c : options.clip_planes) {
         const auto& n = c.normal;
         if (!std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2]) || !std::isfinite(c.d) ||
@@ -102,6 +107,7 @@ void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, cons
                 const TraceHit& hit = traced[k];
                 const size_t i = pixel[k];
                 counters.hits += hit.is_hit();
+                if (hit.is_hit()) ++counters.hits_by_cell_log2[size_t(hit.cell_log2) & 31u];
                 if (options.want_depth) frame.depth[i] = float(hit.t);
                 if (options.want_normal)
                     for (int a = 0; a < 3; ++a) frame.normal[3 * i + a] = hit.is_hit() ? float(hit.normal[a]) : 0.0f;
@@ -138,6 +144,12 @@ public:
         const PinholeCamera pinhole(camera);
         const TileGrid grid = tile_grid_for(camera.width, camera.height, options.tile_size);
         const EmbreeVolumeScene* scene = options.use_embree ? scene_.get() : nullptr;
+        // Level of detail: the cut is the camera's, so frames of this Renderer take turns.
+        std::unique_lock<std::mutex> lod_turn;
+        if (options.lod > 0) {
+            lod_turn = std::unique_lock<std::mutex>(lod_mutex_);
+            kernel_.set_lod(kernel_.user, make_lod_cut(camera, placement_, options.lod));
+        }
         return in_arena([&] {
             return for_each_tile(grid, tiles, all, [&](const PixelRect& rect, TileCounters& counters) {
                 trace_rect(kernel_, scene, pinhole, options, rect, frame, counters);
@@ -166,6 +178,7 @@ private:
     // stable until the next set_options(), which re-points the scene.
     TracerKernel kernel_;
     std::unique_ptr<EmbreeVolumeScene> scene_;
+    mutable std::mutex lod_mutex_;   ///< held by a frame with level of detail (its cut is set on the kernel)
 };
 
 }  // namespace

@@ -21,12 +21,14 @@ namespace octiso {
 
 struct TileCounters {
     uint64_t rays = 0, hits = 0;
+    std::array<uint64_t, 32> hits_by_cell_log2{};   ///< RenderStats::hits_by_cell_log2
 };
 
 /// Runs body(const PixelRect&, TileCounters&) for the tiles `tiles` of `grid` (all tiles when
 /// `all`), in parallel; returns the wall time and the summed counters.
 template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<const int> tiles, bool all, Body&& body) {
     std::atomic<uint64_t> rays{0}, hits{0};
+    std::array<std::atomic<uint64_t>, 32> by_cell{};
     const int n = all ? grid.count() : int(tiles.size());
     const auto t0 = std::chrono::steady_clock::now();
     tbb::parallel_for(
@@ -39,6 +41,8 @@ template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<
                 body(grid.rect(tile), local);
                 rays += local.rays;
                 hits += local.hits;
+                for (size_t k = 0; k < by_cell.size(); ++k)
+                    if (local.hits_by_cell_log2[k]) by_cell[k] += local.hits_by_cell_log2[k];
             }
         },
         tbb::simple_partitioner());
@@ -46,6 +50,7 @@ template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     stats.rays = rays;
     stats.hits = hits;
+    for (size_t k = 0; k < by_cell.size(); ++k) stats.hits_by_cell_log2[k] = by_cell[k];
     stats.threads = tbb::this_task_arena::max_concurrency();
     return stats;
 }

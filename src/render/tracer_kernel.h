@@ -13,6 +13,7 @@
 #include "octiso/octree.h"
 #include "octiso/render.h"
 #include "octiso/volume.h"
+#include "render/lod.h"
 #include "scene/embree_scene.h"
 
 namespace octiso {
@@ -22,6 +23,8 @@ struct TracerKernel {
     const void* user = nullptr;
     EmbreeVolumeScene::TraceFn trace = nullptr;               ///< one ray
     EmbreeVolumeScene::TracePacketFn trace_packet = nullptr;  ///< up to 8 rays
+    /// Level of detail for the next frames (lod.h); between frames only.
+    void (*set_lod)(const void* user, const LodCut& cut) = nullptr;
     Isa isa = Isa::baseline;
     std::shared_ptr<const std::vector<double>> ghost_plane;   ///< RenderOptions::ghost_plane, if any
 };

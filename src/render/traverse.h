@@ -30,6 +30,7 @@
 #include "render/cell.h"
 #include "render/cell_dda.h"
 #include "render/cell_hit.h"
+#include "render/lod.h"
 #include "math/ray.h"
 #include "render/roots.h"
 #include "util/check.h"
@@ -97,6 +98,11 @@ public:
         owned_ = box;
         ghost_ = ghost_plane;
     }
+
+    /// Level of detail for the frames that follow (lod.h; off by default): nodes the cut allows
+    /// are traced as coarse cells of their lattice instead of being descended. Set between
+    /// frames, never during one (the Renderer holds a lock around it).
+    void set_lod(const LodCut& cut) const { lod_ = cut; }
 
     /// First hits of rays[0 .. count), count <= kMaxPacket; lanes with valid[k] == 0 (valid may be
     /// null: all valid) are misses. Every hit equals trace(rays[k]) bit for bit: each lane sees the
@@ -192,6 +198,13 @@ private:
             if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) return false;
             const Coord co = child_origin_of(o, c, half);
             if (restricted_ && !overlaps_owned(co, half)) return false;
+            if (!restricted_ && lod_.on) [[unlikely]] {
+                // A leaf is walked on the coarsest lattice its distance allows; a stored child
+                // stops only where the whole child is one coarse cell, else it is descended.
+                const uint32_t unit = lod_.unit(co, half);
+                if (unit > 1 && (n.is_scalar_leaf(c) || unit == half))
+                    return hit = coarse_cells(w, w.trace, d, co, half, unit, n.is_scalar_leaf(c), n.scalar[c], t_cur, t_next);
+            }
             if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
             else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;
@@ -291,6 +304,20 @@ private:
             const Coord co = child_origin_of(o, int(c), half);
             if (restricted_ && !overlaps_owned(co, half)) continue;
             unsigned hit = 0;
+            if (!restricted_ && lod_.on) [[unlikely]] {
+                // The cut is the node's, not the ray's (lod.h): every lane stops here or none.
+                const uint32_t unit = lod_.unit(co, half);
+                const bool leaf = n.is_scalar_leaf(int(c));
+                if (unit > 1 && (leaf || unit == half)) {
+                    for (unsigned m = entered; m; m &= m - 1) {
+                        const int k = std::countr_zero(m);
+                        if (coarse_cells(p.lane[k], p.trace, d, co, half, unit, leaf, n.scalar[c], c0[c][k], c1[c][k]))
+                            hit |= 1u << k;
+                    }
+                    active &= ~hit;
+                    continue;
+                }
+            }
             if (n.is_scalar_leaf(int(c))) {
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
@@ -426,6 +453,55 @@ private:
                           });
     }
 
+    /// Level of detail: the cells of lattice `unit` (a power of two >= 2) inside the child cube
+    /// [co, co + side)^3 of the node at depth d (w.trace down to d) that the ray crosses on
+    /// [t0, t1), by the one DDA in units of `unit` (planes at multiples of it: the node's own
+    /// mid-planes, so pieces abut exactly). A cell's corners are the lattice voxels at its
+    /// vertices (Octree::lattice_value); on the upper data border the cell is cut to the last
+    /// voxel, whose corners are then voxels off the lattice, read at the finest unit that divides
+    /// them. Inside a scalar leaf every corner in its cube is its value.
+    bool coarse_cells(RayState& w, const uint32_t* trace, int d, const Coord& co, uint32_t side, uint32_t unit, bool is_leaf, T leaf_value,
+                      double t0, double t1) const {
+        const Dims dims = tree_.dims();
+        const uint32_t n[3] = {dims.x, dims.y, dims.z};
+        const int shift = std::countr_zero(unit);
+        const uint32_t o[3] = {co.x, co.y, co.z};
+        DdaBox box;
+        for (int a = 0; a < 3; ++a) {
+            box.lo[a] = int64_t(o[a] >> shift);
+            box.hi[a] = int64_t((uint64_t(o[a]) + side) >> shift);
+            box.top_unit[a] = int64_t((n[a] - 2) >> shift);   // the unit holding the last data cell
+        }
+        box.box_hi = scene_.box_hi;
+        const double leaf = double(leaf_value);
+        return walk_units(w.ray, ScaledCells{double(unit)}, box, t0, t1, w.t_exit,
+                          [&](const int64_t cell[3], double t_in, double t_out, bool closed_end) {
+                              uint32_t q[3], e[3];
+                              for (int a = 0; a < 3; ++a) {
+                                  q[a] = uint32_t(cell[a]) << shift;
+                                  if (q[a] > n[a] - 2) return false;   // beyond the last data cell
+                                  e[a] = std::min(unit, n[a] - 1 - q[a]);
+                              }
+                              double corner[8];
+                              for (int k = 0; k < 8; ++k) {
+                                  const Coord p{q[0] + ((k & 1) ? e[0] : 0u), q[1] + ((k & 2) ? e[1] : 0u),
+                                                q[2] + ((k & 4) ? e[2] : 0u)};
+                                  if (is_leaf && p.x - co.x < side && p.y - co.y < side && p.z - co.z < side) {
+                                      corner[k] = leaf;
+                                      continue;
+                                  }
+                                  const uint32_t bits = p.x | p.y | p.z;
+                                  const uint32_t at = bits == 0 ? unit : std::min(unit, bits & (0u - bits));
+                                  corner[k] = double(tree_.lattice_value(co, p, at, d, trace));
+                              }
+                              const Coord v{q[0], q[1], q[2]};
+                              if (!intersect_coarse_cell(finder_, scene_, w, v, e, corner, t_in, t_out, closed_end))
+                                  return false;
+                              w.hit.cell_log2 = shift;
+                              return true;
+                          });
+    }
+
     bool test_cell(RayState& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
         if constexpr (Recorder::kOn) {
             double lo = corner[0], hi = corner[0];
@@ -442,6 +518,7 @@ private:
     const CellWalkScene scene_;
     const Finder finder_;
     int min_packet_lanes_ = kDefaultMinPacketLanes;
+    mutable LodCut lod_;   ///< set_lod(): per frame, between frames
     static constexpr bool restricted_ = kOwned;
     CellBox owned_;
     const double* ghost_ = nullptr;   ///< the plane x = owned_.hi[0], or null
