@@ -9,7 +9,10 @@
 // same name elsewhere would be an ODR violation).
 #pragma once
 
+#include <signal.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <gtest/gtest.h>
 
@@ -27,7 +30,7 @@ namespace octiso::test {
 
 class ScratchDir {
 public:
-    explicit ScratchDir(const std::string& prefix = "octiso_test") {
+    explicit ScratchDir(const std::string& prefix = "octiso_test") : prefix_(prefix) {
         static int n = 0;
         path_ = std::filesystem::temp_directory_path() /
                 (prefix + "_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
@@ -37,6 +40,7 @@ public:
         if (!lies_allowed_) verify_octree_files();
         std::error_code ec;
         std::filesystem::remove_all(path_, ec);
+        remove_orphans();
     }
     /// For tests that write files with valid checksums and lying min/max on purpose.
     void allow_lying_metadata() { lies_allowed_ = true; }
@@ -78,7 +82,27 @@ private:
         }
     }
 
+    /// A death test's child (gtest's threadsafe style re-runs the test in a new process) builds
+    /// its own fixture and ends in _Exit or a fatal signal handler, so its directory outlives it.
+    /// The parent removes the directories of this prefix whose process no longer exists.
+    void remove_orphans() const {
+        std::error_code ec;
+        const std::string lead = prefix_ + "_";
+        for (const auto& e : std::filesystem::directory_iterator(path_.parent_path(), ec)) {
+            const std::string name = e.path().filename().string();
+            if (name.rfind(lead, 0) != 0) continue;
+            const std::string rest = name.substr(lead.size());
+            const size_t cut = rest.find('_');
+            if (cut == 0 || cut == std::string::npos || rest.find_first_not_of("0123456789") != cut) continue;
+            const pid_t pid = pid_t(std::stol(rest.substr(0, cut)));
+            if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+            std::error_code gone;
+            std::filesystem::remove_all(e.path(), gone);
+        }
+    }
+
     std::filesystem::path path_;
+    std::string prefix_;
     bool lies_allowed_ = false;
 };
 
