@@ -45,12 +45,12 @@ namespace {
 const char* const kLodUsage =
     "usage: octiso-bench lod [--dataset SPEC[,SPEC...]] [--lod 0.5,1,2,4] [--image 512,1024] [--view whole,close]\n"
     "                        [--threads N] [--repeats N] [--rules] [--mri-dir DIR] [--work DIR] [--quick]\n"
-    "                        [--markdown] [--results DIR] [--no-plot]\n"
+    "                        [--markdown] [--results DIR] [--tag T] [--no-plot]\n"
     "  SPEC: FILE.oct@ISO (used as it is), FILE@ISO (a scan in --mri-dir, default /usr/share/mricron/templates)\n"
     "        or NAME:N@ISO (plume, mixing at N^3); scans and synthetics are converted with octiso-convert into\n"
     "        --work (default a temporary folder, removed at the end)\n"
     "  default: plume:1024@40.5, mixing:1024@127.5, ch2better.nii.gz@100.5, ch2better.nii.gz@25.5; 1 thread, 3 rounds\n"
-    "  --quick: plume:64@40.5, 128x128, factors 1,4, 1 round, --rules at units 2";
+    "  --quick: plume:64@40.5, 128x128, factors 1,4, 1 round, --rules at units 2; --tag T: write lod_T.json";
 
 struct DatasetSpec {
     std::string name, source;
@@ -72,6 +72,7 @@ std::vector<DatasetSpec> parse_specs(const std::string& text, const std::string&
         s.is_oct = s.name.size() > 4 && s.name.compare(s.name.size() - 4, 4, ".oct") == 0;
         s.is_synthetic = !s.is_oct && s.name.find(':') != std::string::npos;
         s.source = s.is_oct || s.is_synthetic ? s.name : mri_dir + "/" + s.name;
+        if (s.is_oct) s.name = std::filesystem::path(s.name).filename().string();   // the table's label
         out.push_back(s);
         pos = comma + 1;
     }
@@ -222,6 +223,7 @@ int run_lod(cli::Args& args) {
     const int threads = int(cli::parse_int(args.value("--threads").value_or("1"), "--threads", 1, 1024));
     const int repeats = int(cli::parse_int(args.value("--repeats").value_or(quick ? "1" : "3"), "--repeats", 1, 1000));
     const std::optional<std::string> work_flag = args.value("--work");
+    const std::optional<std::string> tag = args.value("--tag");
     const std::string results = results_dir(args);
     args.finish();
     const std::filesystem::path work =
@@ -399,7 +401,7 @@ int run_lod(cli::Args& args) {
         j.field("normal_error_median_deg", e.normal_median).field("normal_error_p99_deg", e.normal_p99);
         j.field("identical", e.identical);
     };
-    const std::string path = write_json(results, "lod", [&](cli::JsonWriter& j) {
+    const std::string path = write_json(results, tag ? "lod_" + *tag : std::string("lod"), [&](cli::JsonWriter& j) {
         j.begin_object();
         j.field("machine", machine_description()).field("repeats", int64_t(repeats)).field("threads", int64_t(threads));
         j.key("cases").begin_array();
