@@ -63,7 +63,7 @@ std::vector<double> stored_isovalues(const AnyOctree& tree, const std::vector<do
 }
 
 RenderOptions options_of(const AnyOctree& tree, const std::vector<double>& real_iso, int threads, bool depth, bool normal,
-                         const std::string& root_finder, int iterations) {
+                         const std::string& root_finder, int iterations, double lod) {
     if (threads < 0) throw py::value_error("threads: must be >= 0 (0: all cores)");
     RenderOptions o;
     o.isovalues = stored_isovalues(tree, real_iso);
@@ -72,6 +72,7 @@ RenderOptions options_of(const AnyOctree& tree, const std::vector<double>& real_
     o.want_normal = normal;
     o.root_finder = parse_root_finder_name(root_finder);
     o.iterations = iterations;
+    o.lod = lod;   // validated with the rest by the Renderer (ValueError naming --lod)
     return o;
 }
 
@@ -159,15 +160,16 @@ Without angles: the same three-quarter view as octiso-render without camera flag
 
     py::class_<PyRenderer>(m, "Renderer", "Renders frame after frame of one Tree, keeping its Embree scene and threads between calls.")
         .def(py::init([](const AnyOctree& tree, const py::object& iso, const py::object& size, int threads, bool depth, bool normal,
-                         const std::string& root_finder, int iterations) {
+                         const std::string& root_finder, int iterations, double lod) {
                  const std::vector<double> real = isovalues_of(iso);
-                 const RenderOptions o = options_of(tree, real, threads, depth, normal, root_finder, iterations);
+                 const RenderOptions o = options_of(tree, real, threads, depth, normal, root_finder, iterations, lod);
                  const std::array<int, 2> wh = size_of(size);
                  py::gil_scoped_release release;
                  return std::make_unique<PyRenderer>(PyRenderer{tree, tree.make_renderer(o), wh, real});
              }),
              py::arg("tree"), py::arg("iso"), py::arg("size") = py::make_tuple(512, 512), py::arg("threads") = 0,
-             py::arg("depth") = false, py::arg("normal") = false, py::arg("root_finder") = "neubauer", py::arg("iterations") = -1)
+             py::arg("depth") = false, py::arg("normal") = false, py::arg("root_finder") = "neubauer", py::arg("iterations") = -1,
+             py::arg("lod") = 0.0)
         .def_property("iso", [](const PyRenderer& r) { return r.iso; },
                       [](PyRenderer& r, const py::object& iso) {
                           RenderOptions o = r.renderer.options();
@@ -192,8 +194,8 @@ void add_tree_render(py::class_<AnyOctree>& tree_class) {
     tree_class.def(
         "render",
         [](const AnyOctree& tree, const py::object& iso, const std::optional<Camera>& camera, const py::object& size, int threads,
-           bool depth, bool normal, const std::string& root_finder) {
-            const RenderOptions o = options_of(tree, isovalues_of(iso), threads, depth, normal, root_finder, -1);
+           bool depth, bool normal, const std::string& root_finder, double lod) {
+            const RenderOptions o = options_of(tree, isovalues_of(iso), threads, depth, normal, root_finder, -1, lod);
             const Camera c = camera_for(tree, camera, size_of(size));
             Frame f;
             {
@@ -203,10 +205,12 @@ void add_tree_render(py::class_<AnyOctree>& tree_class) {
             return to_python(std::move(f));
         },
         py::arg("iso"), py::arg("camera") = py::none(), py::arg("size") = py::make_tuple(512, 512), py::arg("threads") = 0,
-        py::arg("depth") = false, py::arg("normal") = false, py::arg("root_finder") = "neubauer",
+        py::arg("depth") = false, py::arg("normal") = false, py::arg("root_finder") = "neubauer", py::arg("lod") = 0.0,
         R"(Renders the isosurface(s) `iso` (a number or up to 8, real values: the tree's value_scale applied,
 as octiso-render --iso) into a Frame of `size` (width, height):
-with `camera`, or the default three-quarter framing. depth/normal add those outputs. The GIL is released.)");
+with `camera`, or the default three-quarter framing. depth/normal add those outputs. lod = F > 0 is
+octiso-render --lod F (level of detail: cells up to F pixels wide; 0, the default, is exact).
+The GIL is released.)");
 }
 
 }  // namespace octiso::python

@@ -121,6 +121,18 @@ def test_renderer_keeps_scene_and_matches_one_call_renders():
     assert np.isinf(a.depth).any() and np.isfinite(a.depth).any()
 
 
+def test_level_of_detail_matches_the_tool_and_changes_only_far_views():
+    tree = octiso.build(field((40, 36, 44), np.uint8))
+    exact = tree.render(47, size=(128, 128), depth=True)
+    # Close (under one voxel per pixel) any factor up to 1 is the exact frame.
+    assert np.array_equal(tree.render(47, size=(128, 128), depth=True, lod=1.0).depth, exact.depth)
+    r = octiso.Renderer(tree, 47, size=(128, 128), depth=True, lod=16.0)
+    coarse = r.render()
+    assert coarse.hits > 0
+    assert not np.array_equal(coarse.depth, exact.depth)
+    assert np.array_equal(coarse.depth, tree.render(47, size=(128, 128), depth=True, lod=16.0).depth)
+
+
 def test_frame_arrays_own_their_memory():
     tree = octiso.build(field((16, 16, 16), np.uint8))
     frame = tree.render(60, size=(32, 32))
@@ -194,6 +206,8 @@ def test_bad_arguments_raise_with_the_tools_messages(tmp_path):
         tree.render(50, root_finder="newton")
     with pytest.raises(ValueError, match="size"):
         tree.render(50, size=(0, 10))
+    with pytest.raises(ValueError, match="--lod"):
+        tree.render(50, lod=-1)
     with pytest.raises(ValueError, match="--look"):
         octiso.Camera(eye=(1, 2, 3), look=(1, 2, 3))
     with pytest.raises(ValueError, match="--elevation"):
