@@ -11,7 +11,9 @@
 //   stopping depths  the share of hits per octree depth (dmax: full resolution);
 //   identical        depth and normals bit for bit the exact frame's.
 // Views: "whole" is frame_data_box; "close" keeps its eye and looks through a field of view 8x
-// narrower, so the pixel footprint is 8x smaller (the table prints it, in voxels at the centre).
+// narrower, so the pixel footprint is 8x smaller (the table prints it, in voxels at the centre);
+// "near" (not in the default set) moves the eye halfway to the centre, so that the distance, and
+// with it the cut, varies across the surface: where levels meet, "holes" counts the cracks.
 // --rules compares the representative value of a coarse level (deliverable 1): the dense array
 // reduced by each rule to lattice unit u, placed with spacing u, traced exactly, against the
 // exact frame (whole view, first image size; the array cropped to 8k+1 voxels per axis, its
@@ -43,7 +45,7 @@ namespace octiso::bench {
 namespace {
 
 const char* const kLodUsage =
-    "usage: octiso-bench lod [--dataset SPEC[,SPEC...]] [--lod 0.5,1,2,4] [--image 512,1024] [--view whole,close]\n"
+    "usage: octiso-bench lod [--dataset SPEC[,SPEC...]] [--lod 0.5,1,2,4] [--image 512,1024] [--view whole,close[,near]]\n"
     "                        [--threads N] [--repeats N] [--rules] [--mri-dir DIR] [--work DIR] [--quick]\n"
     "                        [--markdown] [--results DIR] [--tag T] [--no-plot]\n"
     "  SPEC: FILE.oct@ISO (used as it is), FILE@ISO (a scan in --mri-dir, default /usr/share/mricron/templates)\n"
@@ -92,6 +94,9 @@ LoadedVolume dense_of(const DatasetSpec& s) {
 
 struct FrameError {
     uint64_t exact_hits = 0, mismatched = 0;
+    /// Cracks: pixels the exact frame hits and this one misses while this one hits both
+    /// neighbours on a row or on a column (a gap inside a surface, not a shifted silhouette).
+    uint64_t holes = 0;
     double mismatch = 0;   ///< mismatched / exact_hits
     double depth_median = 0, depth_p99 = 0, depth_max = 0;   ///< voxels
     double normal_median = 0, normal_p99 = 0;                ///< degrees
@@ -113,6 +118,11 @@ FrameError compare(const Frame& f, const Frame& exact, double voxel) {
         e.exact_hits += b;
         if (a != b) {
             ++e.mismatched;
+            const size_t w = size_t(f.width), x = i % w, y = i / w;
+            auto hit = [&](size_t j) { return std::isfinite(f.depth[j]); };
+            if (b && x > 0 && x + 1 < w && y > 0 && y + 1 < size_t(f.height) &&
+                ((hit(i - 1) && hit(i + 1)) || (hit(i - w) && hit(i + w))))
+                ++e.holes;
             continue;
         }
         if (!a) continue;
@@ -216,7 +226,8 @@ int run_lod(cli::Args& args) {
         for (size_t p = 0; p <= text.size();) {
             const size_t c = std::min(text.find(',', p), text.size());
             views.push_back(text.substr(p, c - p));
-            if (views.back() != "whole" && views.back() != "close") throw Error("--view", "expected whole or close, found '" + views.back() + "'");
+            if (views.back() != "whole" && views.back() != "close" && views.back() != "near")
+                throw Error("--view", "expected whole, close or near, found '" + views.back() + "'");
             p = c + 1;
         }
     }
@@ -267,6 +278,8 @@ int run_lod(cli::Args& args) {
             for (const std::string& view : views) {
                 Camera camera = frame_data_box(info.dims, info.placement, image, image);
                 if (view == "close") camera.fov_deg = 2 * std::atan(std::tan(camera.fov_deg * M_PI / 360) / 8) * 360 / M_PI;
+                if (view == "near")
+                    for (int a = 0; a < 3; ++a) camera.eye[a] = camera.look[a] + (camera.eye[a] - camera.look[a]) / 2;
                 double centre_distance = 0;
                 for (int a = 0; a < 3; ++a) {
                     const double c = camera.look[a] - camera.eye[a];
@@ -368,11 +381,11 @@ int run_lod(cli::Args& args) {
                 s += (s.empty() ? "" : " ") + std::to_string(it->first) + ":" + fmt(100.0 * double(it->second) / double(hits), 0) + "%";
         return s.empty() ? std::string("-") : s;
     };
-    Table table({"dataset", "iso", "image", "view", "px/voxel", "lod", "ms", "speed-up", "mask mismatch", "depth err med/p99/max",
+    Table table({"dataset", "iso", "image", "view", "px/voxel", "lod", "ms", "speed-up", "mask mismatch", "holes", "depth err med/p99/max",
                  "normal err med/p99 deg", "touched MiB", "of file", "hits by depth", "identical"});
     for (const CaseRow& r : cases)
         table.add({r.dataset, fmt(r.iso, 1), std::to_string(r.image) + "^2", r.view, fmt(r.footprint, 2), fmt(r.lod, 1),
-                   fmt(r.seconds * 1e3, 1), fmt(r.speedup, 2) + " x", fmt(100 * r.error.mismatch, 3) + " %",
+                   fmt(r.seconds * 1e3, 1), fmt(r.speedup, 2) + " x", fmt(100 * r.error.mismatch, 3) + " %", std::to_string(r.error.holes),
                    fmt(r.error.depth_median, 3) + " / " + fmt(r.error.depth_p99, 3) + " / " + fmt(r.error.depth_max, 2),
                    fmt(r.error.normal_median, 2) + " / " + fmt(r.error.normal_p99, 1), fmt(double(r.touched) / 1048576.0, 1),
                    fmt(100.0 * double(r.touched) / double(r.file_bytes), 1) + " %", depths_text(r), r.error.identical ? "yes" : "no"});
@@ -397,6 +410,7 @@ int run_lod(cli::Args& args) {
 
     auto error_json = [](cli::JsonWriter& j, const FrameError& e) {
         j.field("exact_hits", int64_t(e.exact_hits)).field("mismatched", int64_t(e.mismatched)).field("mismatch", e.mismatch);
+        j.field("holes", int64_t(e.holes));
         j.field("depth_error_median", e.depth_median).field("depth_error_p99", e.depth_p99).field("depth_error_max", e.depth_max);
         j.field("normal_error_median_deg", e.normal_median).field("normal_error_p99_deg", e.normal_p99);
         j.field("identical", e.identical);
