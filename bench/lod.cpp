@@ -33,6 +33,7 @@
 #include <tbb/parallel_for.h>
 
 #include "bench/bench.h"
+#include "bench/dataset_spec.h"
 #include "bench/tools.h"
 #include "octiso/any_octree.h"
 #include "octiso/error.h"
@@ -53,33 +54,6 @@ const char* const kLodUsage =
     "        --work (default a temporary folder, removed at the end)\n"
     "  default: plume:1024@40.5, mixing:1024@127.5, ch2better.nii.gz@100.5, ch2better.nii.gz@25.5; 1 thread, 3 rounds\n"
     "  --quick: plume:64@40.5, 128x128, factors 1,4, 1 round, --rules at units 2; --tag T: write lod_T.json";
-
-struct DatasetSpec {
-    std::string name, source;
-    double iso = 0;
-    bool is_oct = false, is_synthetic = false;
-};
-
-std::vector<DatasetSpec> parse_specs(const std::string& text, const std::string& mri_dir) {
-    std::vector<DatasetSpec> out;
-    size_t pos = 0;
-    while (pos <= text.size()) {
-        const size_t comma = std::min(text.find(',', pos), text.size());
-        const std::string item = text.substr(pos, comma - pos);
-        const size_t at = item.rfind('@');
-        if (at == std::string::npos) throw Error("--dataset", "expected FILE@ISO or NAME:N@ISO, found '" + item + "'");
-        DatasetSpec s;
-        s.name = item.substr(0, at);
-        s.iso = cli::parse_double(item.substr(at + 1), "--dataset");
-        s.is_oct = s.name.size() > 4 && s.name.compare(s.name.size() - 4, 4, ".oct") == 0;
-        s.is_synthetic = !s.is_oct && s.name.find(':') != std::string::npos;
-        s.source = s.is_oct || s.is_synthetic ? s.name : mri_dir + "/" + s.name;
-        if (s.is_oct) s.name = std::filesystem::path(s.name).filename().string();   // the table's label
-        out.push_back(s);
-        pos = comma + 1;
-    }
-    return out;
-}
 
 /// The dense volume of a scan or synthetic (for --rules); empty for a .oct given as it is.
 LoadedVolume dense_of(const DatasetSpec& s) {
@@ -209,10 +183,12 @@ int run_lod(cli::Args& args) {
     const bool quick = args.flag("--quick"), markdown = args.flag("--markdown"), no_plot = args.flag("--no-plot");
     const bool rules = args.flag("--rules");
     const std::string mri_dir = args.value("--mri-dir").value_or("/usr/share/mricron/templates");
-    const auto specs = parse_specs(
+    auto specs = parse_dataset_specs(
         args.value("--dataset").value_or(quick ? "plume:64@40.5"
                                                : "plume:1024@40.5,mixing:1024@127.5,ch2better.nii.gz@100.5,ch2better.nii.gz@25.5"),
         mri_dir);
+    for (DatasetSpec& s : specs)
+        if (s.is_oct) s.name = std::filesystem::path(s.name).filename().string();   // the table's label
     std::vector<double> factors{0};
     for (double f : cli::parse_list(args.value("--lod").value_or(quick ? "1,4" : "0.5,1,2,4"), "--lod")) {
         if (!(f > 0) || !std::isfinite(f)) throw Error("--lod", "factors must be finite and > 0 (0, the exact frame, is always run)");

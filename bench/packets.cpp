@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "bench/bench.h"
+#include "bench/dataset_spec.h"
 #include "bench/peers_mesh.h"
 #include "octiso/any_octree.h"
 #include "octiso/error.h"
@@ -41,29 +42,6 @@ const char* const kPacketsUsage =
     "  SPEC: FILE@ISO (a file in --mri-dir, default /usr/share/mricron/templates) or NAME:N@ISO (plume, mixing)\n"
     "  default: ch2, ch2bet, ch2better at 100.5 and 25.5, aal.nii.gz@0.5, plume:256@40.5, mixing:256@127.5;\n"
     "  --quick: plume:48@40.5, 128x128, 1 thread, 2 repeats";
-
-struct DatasetSpec {
-    std::string name, source;
-    double iso = 0;
-};
-
-std::vector<DatasetSpec> parse_specs(const std::string& text, const std::string& mri_dir) {
-    std::vector<DatasetSpec> out;
-    size_t pos = 0;
-    while (pos <= text.size()) {
-        const size_t comma = std::min(text.find(',', pos), text.size());
-        const std::string item = text.substr(pos, comma - pos);
-        const size_t at = item.find('@');
-        if (at == std::string::npos) throw Error("--dataset", "expected FILE@ISO or NAME:N@ISO, found '" + item + "'");
-        DatasetSpec s;
-        s.name = item.substr(0, at);
-        s.iso = cli::parse_double(item.substr(at + 1), "--dataset");
-        s.source = s.name.find(':') != std::string::npos ? s.name : mri_dir + "/" + s.name;
-        out.push_back(s);
-        pos = comma + 1;
-    }
-    return out;
-}
 
 LoadedVolume open_spec(const DatasetSpec& s) {
     const size_t colon = s.name.find(':');
@@ -166,7 +144,7 @@ int run_packets(cli::Args& args) {
         quick ? "plume:48@40.5"
               : "ch2.nii.gz@100.5,ch2.nii.gz@25.5,ch2bet.nii.gz@100.5,ch2bet.nii.gz@25.5,ch2better.nii.gz@100.5,"
                 "ch2better.nii.gz@25.5,aal.nii.gz@0.5,plume:256@40.5,mixing:256@127.5";
-    const auto specs = parse_specs(args.value("--dataset").value_or(default_specs), mri_dir);
+    const auto specs = parse_dataset_specs(args.value("--dataset").value_or(default_specs), mri_dir);
     std::vector<int> images, thread_counts;
     for (double v : cli::parse_list(args.value("--image").value_or(quick ? "128" : "512"), "--image")) images.push_back(int(v));
     for (double v : cli::parse_list(args.value("--threads").value_or(quick ? "1" : "1,2"), "--threads"))

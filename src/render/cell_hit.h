@@ -74,6 +74,32 @@ struct RayState {
     }
 };
 
+/// The nearest root of the isovalues inside [lo, hi] (the corners' range) on the cell-local
+/// segment p_in -> p_out, which is the ray piece [t_in, t_out): fills `w.hit` (the normal's
+/// gradient per world unit through `cell_spacing`) and returns true, or false with no root.
+template <class Finder>
+inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RayState& w, const double corner[8], double lo, double hi,
+                         const std::array<double, 3>& p_in, const std::array<double, 3>& p_out, double t_in, double t_out,
+                         bool closed_end, const std::array<double, 3>& cell_spacing) {
+    double best_s = 2.0;
+    int best = -1;
+    for (int i = 0; i < scene.iso_count; ++i) {
+        const double iso = scene.isovalues[i];
+        if (!(lo <= iso && iso <= hi)) continue;
+        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end);
+        if (s >= 0 && s < best_s) best_s = s, best = i;
+    }
+    if (best < 0) return false;
+    w.hit.t = t_in + best_s * (t_out - t_in);
+    w.hit.iso_index = best;
+    if (w.want_normal) {
+        std::array<double, 3> p_hit;
+        for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + best_s * (p_out[a] - p_in[a]);
+        w.hit.normal = world_normal(corner, p_hit, cell_spacing, w.world_dir);
+    }
+    return true;
+}
+
 /// Tests cell v (lower corner, index space) with corners `corner` (order i + 2j + 4k) on the ray
 /// piece [t_in, t_out) ([t_in, t_out] when closed_end). On a hit fills `w.hit` and returns true.
 template <class Finder>
@@ -92,23 +118,7 @@ inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, Ray
         p_in[a] = snap_to_face(o_cell[a] + t_in * r.dir[a]);
         p_out[a] = snap_to_face(o_cell[a] + t_out * r.dir[a]);
     }
-    double best_s = 2.0;
-    int best = -1;
-    for (int i = 0; i < scene.iso_count; ++i) {
-        const double iso = scene.isovalues[i];
-        if (!(lo <= iso && iso <= hi)) continue;
-        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end);
-        if (s >= 0 && s < best_s) best_s = s, best = i;
-    }
-    if (best < 0) return false;
-    w.hit.t = t_in + best_s * (t_out - t_in);
-    w.hit.iso_index = best;
-    if (w.want_normal) {
-        std::array<double, 3> p_hit;
-        for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + best_s * (p_out[a] - p_in[a]);
-        w.hit.normal = world_normal(corner, p_hit, scene.placement.spacing, w.world_dir);
-    }
-    return true;
+    return nearest_root(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end, scene.placement.spacing);
 }
 
 /// Level of detail (lod.h): intersect_cell on the coarse cell with lower corner v and sides
@@ -133,23 +143,7 @@ inline bool intersect_coarse_cell(const Finder& finder, const CellWalkScene& sce
         p_out[a] = snap_to_face((o + t_out * r.dir[a]) / e);
         cell_spacing[a] = scene.placement.spacing[a] * e;
     }
-    double best_s = 2.0;
-    int best = -1;
-    for (int i = 0; i < scene.iso_count; ++i) {
-        const double iso = scene.isovalues[i];
-        if (!(lo <= iso && iso <= hi)) continue;
-        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end);
-        if (s >= 0 && s < best_s) best_s = s, best = i;
-    }
-    if (best < 0) return false;
-    w.hit.t = t_in + best_s * (t_out - t_in);
-    w.hit.iso_index = best;
-    if (w.want_normal) {
-        std::array<double, 3> p_hit;
-        for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + best_s * (p_out[a] - p_in[a]);
-        w.hit.normal = world_normal(corner, p_hit, cell_spacing, w.world_dir);
-    }
-    return true;
+    return nearest_root(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end, cell_spacing);
 }
 
 OCTISO_ISA_END

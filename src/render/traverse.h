@@ -410,21 +410,27 @@ private:
 
         // Skip the inner cells [co, co + side - 1)^3: constant, never crossed by another iso.
         double ti0 = t0, ti1 = t1;
-        const uint32_t lo[3] = {co.x, co.y, co.z};
-        for (int a = 0; a < 3; ++a) {
-            const double p0 = double(lo[a]), p1 = double(lo[a] + side - 1);
-            const double d = w.ray.dir[a];
-            if (d == 0) {
-                if (w.ray.origin[a] < p0 || w.ray.origin[a] >= p1) ti1 = ti0 - 1;   // never inside
-                continue;
-            }
-            const double ta = w.ray.plane_t(a, d > 0 ? p0 : p1), tb = w.ray.plane_t(a, d > 0 ? p1 : p0);
-            ti0 = std::max(ti0, ta);
-            ti1 = std::min(ti1, tb);
-        }
+        inside_box(w.ray, co, side - 1, ti0, ti1);
         if (!(ti0 < ti1)) return walk_cells(w, co, side, t0, t1, partial, gather);
         if (ti0 > t0 && walk_cells(w, co, side, t0, ti0, partial, gather)) return true;
         return ti1 < t1 && walk_cells(w, co, side, ti1, t1, partial, gather);
+    }
+
+    /// Cuts [ti0, ti1) to where the ray is inside the box [lo, lo + extent]^3 (open at the upper
+    /// faces); leaves ti0 >= ti1 where it never is. A scalar leaf's constant interior.
+    static void inside_box(const IndexRay& r, const Coord& lo, uint32_t extent, double& ti0, double& ti1) {
+        const uint32_t o[3] = {lo.x, lo.y, lo.z};
+        for (int a = 0; a < 3; ++a) {
+            const double p0 = double(o[a]), p1 = double(o[a] + extent);
+            const double d = r.dir[a];
+            if (d == 0) {
+                if (r.origin[a] < p0 || r.origin[a] >= p1) ti1 = ti0 - 1;   // never inside
+                continue;
+            }
+            const double ta = r.plane_t(a, d > 0 ? p0 : p1), tb = r.plane_t(a, d > 0 ? p1 : p0);
+            ti0 = std::max(ti0, ta);
+            ti1 = std::min(ti1, tb);
+        }
     }
 
     /// The cells of the box [lo, lo + side)^3 that the ray crosses on [t0, t1), in order, by the
@@ -539,17 +545,7 @@ private:
         // As scalar_leaf does at full resolution: the coarse cells with all 8 corners in the
         // leaf, [co, co + side - unit)^3, are constant and never crossed by another isovalue.
         double ti0 = t0, ti1 = t1;
-        for (int a = 0; a < 3; ++a) {
-            const double p0 = double(o[a]), p1 = double(o[a] + side - unit);
-            const double dir = w.ray.dir[a];
-            if (dir == 0) {
-                if (w.ray.origin[a] < p0 || w.ray.origin[a] >= p1) ti1 = ti0 - 1;   // never inside
-                continue;
-            }
-            const double ta = w.ray.plane_t(a, dir > 0 ? p0 : p1), tb = w.ray.plane_t(a, dir > 0 ? p1 : p0);
-            ti0 = std::max(ti0, ta);
-            ti1 = std::min(ti1, tb);
-        }
+        inside_box(w.ray, co, side - unit, ti0, ti1);
         if (!(ti0 < ti1)) return walk(t0, t1);
         if (ti0 > t0 && walk(t0, ti0)) return true;
         return ti1 < t1 && walk(ti1, t1);
