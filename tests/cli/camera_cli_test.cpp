@@ -128,7 +128,8 @@ TEST_F(CameraCli, CombinationsWithoutOneMeaningAreRefused) {
     for (const std::string& bad : {"--view sideways" + png, "--view front --azimuth 10" + png, "--view top --elevation 10" + png,
                                   "--orbit 3 --eye 1,2,3" + series, "--orbit 3 --view left" + series, "--orbit 3" + png,
                                   "--orbit 0" + series, "--elevation 90" + png, "--zoom 0" + png, "--zoom -2" + png, "--spp 0" + png,
-                                  "--spp 257" + png, "--azimuth nan" + png}) {
+                                  "--spp 257" + png, "--azimuth nan" + png, "--lod -1" + png, "--lod nan" + png,
+                                  "--lod 2 --distribute data" + png}) {
         SCOPED_TRACE(bad);
         const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 60 --size 16x16 " + bad);
         EXPECT_EQ(r.status, 2);

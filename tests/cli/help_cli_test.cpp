@@ -19,7 +19,7 @@ struct ToolFlags {
 const ToolFlags kTools[] = {
     {"octiso-render",
      {"-o, --output", "--depth", "--normal", "--json", "--steps", "--view", "--azimuth", "--elevation", "--zoom", "--orbit", "--eye",
-      "--look", "--up", "--fov", "--size", "--spp", "--shading", "--background", "--colour", "--root-finder", "--iterations",
+      "--look", "--up", "--fov", "--size", "--spp", "--lod", "--shading", "--background", "--colour", "--root-finder", "--iterations",
       "--no-embree", "--threads", "--debug-pixel", "--version", "--help", "--iso", "--traversal", "--isa", "--distribute", "--shadows",
       "--ao", "--ao-distance", "--opacity", "--clip", "--clip-cap", "--progress"}},
     {"octiso-info", {"--json", "--bins", "--verify", "--extract-raw", "--step", "--endian", "--version", "--help"}},
