@@ -4,7 +4,8 @@
 //   frame of the dense array decimated by u (every u-th voxel, spacing u): same hit mask, depths
 //   and normals within the root finder's bar, for packets and single rays, with Embree and without;
 // - close up (the cut allows less than 2 voxels anywhere) the frame is the exact one bit for bit,
-//   and lod 0 is the exact frame.
+//   and lod 0 is the exact frame;
+// - shadow and AO rays see the primary rays' coarse surface (the look of the decimated array).
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -12,8 +13,10 @@
 
 #include <gtest/gtest.h>
 
+#include "octiso/any_octree.h"
 #include "octiso/build.h"
 #include "octiso/error.h"
+#include "octiso/look.h"
 #include "octiso/render.h"
 #include "render/render_test_util.h"
 
@@ -113,6 +116,53 @@ TEST(Lod, UniformCutIsTheExactFrameOfTheDecimatedArray) {
     expect_uniform_cut_matches_decimated<int16_t>(Field::MarschnerLobb, {65, 65, 65}, 4, 47);
     expect_uniform_cut_matches_decimated<float>(Field::Torus, {81, 81, 49}, 16, 50.5);
     expect_uniform_cut_matches_decimated<double>(Field::Sierpinski, {81, 81, 81}, 4, 60);   // scalar leaves
+}
+
+/// Pixels of two colour frames that differ by more than 2 in some channel.
+size_t differing_pixels(const Frame& a, const Frame& b) {
+    size_t n = 0;
+    for (size_t i = 0; i < a.rgb.size(); i += 3) {
+        bool differ = false;
+        for (int k = 0; k < 3; ++k) differ |= std::abs(int(a.rgb[i + k]) - int(b.rgb[i + k])) > 2;
+        n += differ;
+    }
+    return n;
+}
+
+TEST(Lod, ShadowAndAoRaysSeeTheSameCoarseSurface) {
+    // Where the cut is uniform at unit u, the look (shadows, AO) of the LOD frame is the look of
+    // the decimated array traced exactly, up to the root finder's rounding at grazing rays.
+    const uint32_t unit = 4;
+    const DenseVolume<uint8_t> v = make_field<uint8_t>(Field::MarschnerLobb, {65, 65, 65});
+    const DenseVolume<uint8_t> coarse = decimate(v, unit);
+    Placement coarse_placement;
+    coarse_placement.spacing = {double(unit), double(unit), double(unit)};
+    const AnyOctree tree = AnyOctree::build(v.view(), Placement{}, {});
+    const AnyOctree coarse_tree = AnyOctree::build(coarse.view(), coarse_placement, {});
+    double factor = 0;
+    const Camera camera = far_camera(v.dims, 96, unit, factor);
+    // AO reach is in voxels of the tree: the same 12 world units for both.
+    auto shaded = [&](const AnyOctree& t, double lod, double look_lod) {
+        Look look;
+        look.shadows = true;
+        look.ao_samples = 4;
+        look.ao_distance_voxels = 12.0 / std::fabs(t.placement().spacing[0]);
+        RenderOptions o;
+        o.isovalues = {47};
+        o.want_colour = false, o.want_depth = o.want_normal = true;
+        o.lod = lod;
+        Frame f = t.render(camera, o);
+        o.lod = look_lod;
+        LookShader(t, o, look, ShadingModel::kit).shade(camera, Shading{}, f);
+        return f;
+    };
+    const Frame reference = shaded(coarse_tree, 0, 0), lod = shaded(tree, factor, factor);
+    size_t hits = 0;
+    for (float d : reference.depth) hits += std::isfinite(d);
+    ASSERT_GT(hits, 1000u);
+    EXPECT_LE(differing_pixels(lod, reference), hits / 200) << "of " << hits << " hit pixels";
+    // Not vacuous: secondary rays through the full-resolution field shade the coarse hits otherwise.
+    EXPECT_GT(differing_pixels(shaded(tree, factor, 0), reference), hits / 20);
 }
 
 TEST(Lod, CloseUpAndLodZeroAreTheExactFrame) {
