@@ -18,10 +18,11 @@ namespace octiso {
 namespace {
 
 const char* kUsage =
-    "usage: octiso-view FILE.oct [--port P] [--host H] [--threads N] [--iso V]\n"
+    "usage: octiso-view FILE.oct [--port P] [--host H] [--threads N] [--iso V] [--lod F]\n"
     "  serves an interactive viewer of FILE.oct at http://H:P/ (default 127.0.0.1:8080; --port 0 picks a free port);\n"
     "  --iso: the isovalue the page starts at (default: the middle of the data's range); like every value\n"
-    "  on the page a real value (a scaled NIfTI's stored * scl_slope + scl_inter, as octiso-render --iso)";
+    "  on the page a real value (a scaled NIfTI's stored * scl_slope + scl_inter, as octiso-render --iso);\n"
+    "  --lod F: level of detail of every frame, as octiso-render --lod F (default 0: full resolution)";
 
 int run(std::vector<std::string>& argv) {
     for (const std::string& a : argv)   // --help wins over every other argument
@@ -29,7 +30,7 @@ int run(std::vector<std::string>& argv) {
             std::cout << kUsage << "\n";
             return 0;
         }
-    const cli::Flags args(argv, {"--port", "--host", "--threads", "--iso"}, {});
+    const cli::Flags args(argv, {"--port", "--host", "--threads", "--iso", "--lod"}, {});
     const auto port = args.value("--port"), host = args.value("--host"), threads = args.value("--threads");
     const auto iso = args.value("--iso");
     const std::vector<std::string> inputs = args.positional();
@@ -43,6 +44,8 @@ int run(std::vector<std::string>& argv) {
     const int n_threads = threads ? int(cli::parse_int(*threads, "--threads", 1, 4096)) : 0;
     std::optional<double> initial_iso;
     if (iso) initial_iso = cli::parse_double(*iso, "--iso");
+    const auto lod = args.value("--lod");
+    const double lod_factor = lod ? cli::parse_double(*lod, "--lod") : 0.0;
 
     // Signals are taken by one thread with sigwait, so no handler runs inside httplib's workers;
     // blocked before any thread exists, so every thread inherits the mask. A shell starts a
@@ -56,7 +59,7 @@ int run(std::vector<std::string>& argv) {
     sigaddset(&stop_signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
-    view::ViewSession session(inputs[0], n_threads, initial_iso);
+    view::ViewSession session(inputs[0], n_threads, initial_iso, lod_factor);
     view::ViewServer server(session, options);
     if (!view::is_loopback_host(options.host))
         std::fprintf(stderr, "octiso-view: warning: listening on %s: every machine that reaches this address can use the "

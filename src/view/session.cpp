@@ -110,9 +110,10 @@ Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_by
     return h;
 }
 
-std::string render_command(const std::string& path, const Camera& camera, double iso, const Look& look, uint32_t step,
+std::string render_command(const std::string& path, const Camera& camera, double iso, const Look& look, double lod, uint32_t step,
                            uint32_t step_count) {
     std::string c = "octiso-render " + shell_quote(path) + " --iso " + exact(iso);
+    if (lod > 0) c += " --lod " + exact(lod);
     // Without the look the viewer shows the Renderer's own colour (headlight); octiso-render's
     // default is the light kit (deferred shading), so the command names the headlight to
     // reproduce the frame exactly. Shadows and AO need the kit, octiso-render's default.
@@ -127,8 +128,16 @@ std::string render_command(const std::string& path, const Camera& camera, double
     return c;
 }
 
-ViewSession::ViewSession(const std::string& path, int threads, std::optional<double> initial_iso)
-    : path_(path), threads_(threads), file_(std::make_shared<const OctFile>(OctFile::open(path))) {
+namespace {
+/// The level-of-detail factor, checked before the file is opened (a bad flag is named first).
+double checked_lod(double lod) {
+    if (!(std::isfinite(lod) && lod >= 0)) throw Error("--lod", "expected a finite factor >= 0 (0: full resolution)");
+    return lod;
+}
+}  // namespace
+
+ViewSession::ViewSession(const std::string& path, int threads, std::optional<double> initial_iso, double lod)
+    : path_(path), threads_(threads), lod_(checked_lod(lod)), file_(std::make_shared<const OctFile>(OctFile::open(path))) {
     if (file_->info().step_count == 0) throw Error(path, "the file has no steps");
     scale_ = file_->info().value_scale;
     renderers_.resize(file_->info().step_count);
@@ -164,6 +173,7 @@ FrameReply ViewSession::render(const FrameRequest& request) {
     // command, which carries the real value, traces the same stored isovalue bit for bit.
     options.isovalues = {scale_.stored(request.iso)};
     options.threads = threads_;
+    options.lod = lod_;
     // The kernel directly, without Embree's dispatch: the same pixels (RenderPaths.
     // EmbreeAndDirectGiveIdenticalFrames, colour and AOVs), 1-5 % less per frame (BENCHMARKS.md, packets).
     options.use_embree = false;
@@ -197,7 +207,7 @@ FrameReply ViewSession::render(const FrameRequest& request) {
         reply.content_type = "image/png";
     }
     reply.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    reply.command = render_command(path_, reply.camera, request.iso, look, request.step, step_count());
+    reply.command = render_command(path_, reply.camera, request.iso, look, lod_, request.step, step_count());
     return reply;
 }
 

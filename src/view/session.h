@@ -44,7 +44,8 @@ public:
     /// Opens `path` (OctFile::open: header and tables checked; step 0 validated here, so a bad
     /// file fails before the server starts). Throws Error(path, ...). threads: 0 = all cores.
     /// initial_iso: the real isovalue the page starts at (/info "initial_iso"); none: the middle of the range.
-    ViewSession(const std::string& path, int threads, std::optional<double> initial_iso = {});
+    /// lod: level of detail of every frame (RenderOptions::lod, octiso-render --lod; 0: exact).
+    ViewSession(const std::string& path, int threads, std::optional<double> initial_iso = {}, double lod = 0);
 
     /// Renders `request` (its step's Renderer made on first use). Not thread-safe: callers
     /// serialise (the Coalescer does). request.iso is a real value. Without shadows and AO the
@@ -68,6 +69,7 @@ private:
 
     std::string path_;
     int threads_;
+    double lod_ = 0;
     std::shared_ptr<const OctFile> file_;
     ValueScale scale_;                                   // the file's stored-to-real values
     std::vector<std::unique_ptr<Renderer>> renderers_;   // per step, null until first used
@@ -90,11 +92,11 @@ private:
 /// the page draws no histogram).
 Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_bytes);
 
-/// The octiso-render command line for `camera`, the real isovalue `iso` and `look` (shadows and
-/// ao_samples only; the rest at octiso-render's defaults) on `path` (step `step` of a file of
-/// `step_count` steps): numbers in the shortest form that reads back to the same double, so
-/// octiso-render converts the same real value to the same stored one.
-std::string render_command(const std::string& path, const Camera& camera, double iso, const Look& look, uint32_t step,
+/// The octiso-render command line for `camera`, the real isovalue `iso`, `look` (shadows and
+/// ao_samples only; the rest at octiso-render's defaults) and level of detail `lod` (0: none) on
+/// `path` (step `step` of a file of `step_count` steps): numbers in the shortest form that reads
+/// back to the same double, so octiso-render converts the same real value to the same stored one.
+std::string render_command(const std::string& path, const Camera& camera, double iso, const Look& look, double lod, uint32_t step,
                            uint32_t step_count);
 
 }  // namespace octiso::view

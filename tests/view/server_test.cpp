@@ -126,6 +126,25 @@ TEST_F(ViewServerTest, FrameIsTheRenderersImageAndItsCommandReproducesTheCamera)
               std::string::npos) << res->get_header_value("X-Octiso-Stats");
 }
 
+TEST_F(ViewServerTest, LevelOfDetailFramesAreTheRenderersAndTheirCommandSaysSo) {
+    AnyOctree::build(make_synthetic(parse_synthetic("marschner-lobb:40")), {}).save(path_);
+    session_ = std::make_unique<ViewSession>(path_, 2, std::nullopt, 8.0);   // --lod 8: far coarser than exact (no server)
+    const AnyOctree tree = AnyOctree::open(path_);
+    FrameRequest request;
+    request.iso = 0.5, request.width = 64, request.height = 48;
+    const FrameReply reply = session_->render(request);
+    RenderOptions options;
+    options.isovalues = {0.5};
+    options.lod = 8;
+    const Camera camera = session_->camera_for(request);
+    const Frame expected = tree.render(camera, options);
+    options.lod = 0;
+    EXPECT_NE(encode_png(tree.render(camera, options)), encode_png(expected)) << "the factor coarsens this view";
+    EXPECT_EQ(reply.body, encode_png(expected));
+    EXPECT_NE(reply.command.find(" --iso 0.5 --lod 8 "), std::string::npos) << reply.command;
+    EXPECT_THROW(ViewSession(path_, 1, std::nullopt, -1.0), Error);
+}
+
 TEST_F(ViewServerTest, RgbaFrameIsTheRenderersPixelsAsTheyAre) {
     start();
     auto res = get("/frame?iso=5.5&az=30&el=-20&zoom=1.5&w=48&h=32&seq=4&enc=rgba");

@@ -49,6 +49,8 @@ TEST_F(ViewCli, BadFileOrFlagsExitTwoWithOneLine) {
         {"'" + junk + "' --threads 0", "--threads"},
         {"'" + junk + "' --bogus", "--bogus"},
         {"'" + junk + "' --iso abc", "--iso"},
+        {"'" + junk + "' --lod -1", "--lod"},
+        {"'" + junk + "' --lod abc", "--lod"},
     };
     for (const auto& [args, needle] : cases) {
         std::string out, err;
