@@ -1,6 +1,7 @@
 // libFuzzer target: whatever .oct loads (after re-checksumming) is rendered at 12x12 with an
 // isovalue taken from the input, colour, depth and normals, through the Embree path and the
-// direct one. Every pixel must come out finite (depth: finite or +inf), the normals unit or 0.
+// direct one, at full resolution or with a level of detail (byte 8, bits 1-3: --lod 0 .. 64).
+// Every pixel must come out finite (depth: finite or +inf), the normals unit or 0.
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -16,6 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     double iso;
     std::memcpy(&iso, data, sizeof iso);
     const bool embree = data[8] & 1;
+    constexpr double kLod[8] = {0, 0.5, 1, 2, 4, 8, 16, 64};
+    const double lod = kLod[(data[8] >> 1) & 7];
     std::vector<uint8_t> bytes(data + 9, data + size);
     octiso::fuzz::rechecksum(bytes);
     octiso::fuzz::MemFile f(bytes.data(), bytes.size(), "render");
@@ -27,6 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         options.isovalues = {iso};
         options.want_depth = options.want_normal = true;
         options.use_embree = embree;
+        options.lod = lod;
         options.threads = 1;
         const octiso::RenderLimits limits{info.iso_range, f.path()};
         octiso::validate_options(options, limits);
