@@ -32,12 +32,14 @@
 namespace octiso {
 
 struct LodCut {
-    bool on = false;
     std::array<double, 3> eye{};     ///< the camera's eye in index space
     std::array<double, 3> scale{};   ///< |spacing|: index-space lengths to world lengths, per axis
     /// F x the pixel's width per unit of distance, in voxels of the coarsest axis: the coarse cell
     /// side (in voxels) allowed at world distance r is r x this.
     double voxels_per_distance = 0;
+
+    /// Level of detail is on: a positive factor made the cut (make_lod_cut); 0, the default, is off.
+    OCTISO_ALWAYS_INLINE bool on() const { return voxels_per_distance > 0; }
 
     /// The lattice unit for the cube [o, o + side]^3: the largest power of two no larger than the
     /// allowed cell side at the cube's nearest point to the eye, at most `side`; 1 below two
@@ -65,7 +67,6 @@ struct LodCut {
 inline LodCut make_lod_cut(const Camera& camera, const Placement& placement, double factor) {
     LodCut cut;
     if (!(factor > 0)) return cut;
-    cut.on = true;
     double widest = 0;
     for (int a = 0; a < 3; ++a) {
         cut.scale[a] = std::fabs(placement.spacing[a]);

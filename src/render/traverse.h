@@ -198,7 +198,7 @@ private:
             if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) return false;
             const Coord co = child_origin_of(o, c, half);
             if (restricted_ && !overlaps_owned(co, half)) return false;
-            if (!restricted_ && lod_.on) [[unlikely]] {
+            if (!restricted_ && lod_.on()) [[unlikely]] {
                 // A leaf is walked on the coarsest lattice its distance allows; a stored child
                 // stops only where the whole child is one coarse cell, else it is descended.
                 const uint32_t unit = lod_.unit(co, half);
@@ -304,7 +304,7 @@ private:
             const Coord co = child_origin_of(o, int(c), half);
             if (restricted_ && !overlaps_owned(co, half)) continue;
             unsigned hit = 0;
-            if (!restricted_ && lod_.on) [[unlikely]] {
+            if (!restricted_ && lod_.on()) [[unlikely]] {
                 // The cut is the node's, not the ray's (lod.h): every lane stops here or none.
                 const uint32_t unit = lod_.unit(co, half);
                 const bool leaf = n.is_scalar_leaf(int(c));
@@ -464,7 +464,8 @@ private:
     /// once, its corners the samples its siblings keep (format 4: the voxel at each stored child's
     /// lower corner, a leaf's value) or lattice reads beyond the node: with the leaf-interior skip
     /// of coarse_cells, 1.07 x / 1.05 x faster frames at F = 2 / 4 on plume 1024^3 than walking it
-    /// as a box of one unit (BENCHMARKS "Level of detail"). Everything else walks.
+    /// as a box of one unit (two builds alternated under load, no JSON: a direction, BENCHMARKS
+    /// "Level of detail"). Everything else walks.
     bool coarse_child(RayState& w, const uint32_t* trace, int d, const InteriorNode<T>& n, int c, const Coord& co,
                       uint32_t side, uint32_t unit, double t0, double t1) const {
         const Dims dims = tree_.dims();

@@ -51,9 +51,25 @@ template <typename T> void expect_lattice_values(Field field, Dims dims) {
             for (uint32_t y = 0; y < dims.y; y += unit)
                 for (uint32_t x = 0; x < dims.x; x += unit) {
                     const T want = v.values[x + uint64_t(dims.x) * (y + uint64_t(dims.y) * z)];
-                    // From the root (depth 0) and, as the traversal does, from a traced start.
+                    // From the root (depth 0).
                     ASSERT_EQ(tree.lattice_value(Coord{}, Coord{x, y, z}, unit, 0, trace), want)
                         << "unit " << unit << " at " << x << "," << y << "," << z;
+                    // As the traversal does: from the lower corner of the coarse cell whose upper
+                    // corner q is, with that corner's trace down to the node whose children have
+                    // side unit (or the leaf or cap parent above it), climbing to q's ancestor.
+                    const Coord start{x >= unit ? x - unit : 0u, y >= unit ? y - unit : 0u, z >= unit ? z - unit : 0u};
+                    int d = 0;
+                    uint32_t index = 0;
+                    for (;;) {
+                        trace[d] = index;
+                        const auto& n = tree.node(d, index);
+                        const int c = octant_of(start, tree.child_bit(d));
+                        if (tree.child_bit(d) <= unit || n.is_scalar_leaf(c) || d + 1 == tree.cap_depth()) break;
+                        index = n.child_index(c);
+                        ++d;
+                    }
+                    ASSERT_EQ(tree.lattice_value(start, Coord{x, y, z}, unit, d, trace), want)
+                        << "unit " << unit << " at " << x << "," << y << "," << z << " from depth " << d;
                 }
 }
 
