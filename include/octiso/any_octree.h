@@ -76,8 +76,11 @@ public:
     Dims dims() const;
     const Placement& placement() const;
     int dmax() const;
-    /// The header and sizes; value_range reads the root node only, so this is cheap.
+    /// The header and sizes; value_range reads the root node only, so this is cheap (but the sizes
+    /// of a step opened with Verify::Touched count every node: OctFile::step_sizes).
     AnyOctreeInfo info() const;
+    /// The data's exact stored range from the root node (info().value_range without the sizes).
+    std::optional<std::array<double, 2>> value_range() const;
     /// The file this step was opened from; null for a built octree.
     const std::shared_ptr<const OctFile>& file() const;
 

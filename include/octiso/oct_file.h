@@ -60,8 +60,20 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-/// How much of each step the loader checks before handing it out.
-enum class Verify { Full, IndicesOnly };   ///< Full also recomputes every section checksum
+/// How much of each step the loader checks, and when.
+///  - Full: at the step's first use, every section checksum, then every node (validate.h).
+///  - IndicesOnly: the same without the checksums.
+///  - Touched: at first use only the counts; each block of nodes when a thread first reads it,
+///    with the node checks of Full that memory safety rests on (no read outside the file on any
+///    input), and neither checksums nor the rules across nodes (format/touch_validation.h).
+///    A defect is reported by check_unchanged(). Costs the first frame what it touches, not
+///    the file (issue 13: a 30 GB file is no longer read whole before its first pixel).
+enum class Verify { Full, IndicesOnly, Touched };
+
+/// Verify::Touched's progress: the file in blocks, and how many were checked so far.
+struct TouchStats {
+    uint64_t blocks = 0, checked = 0, block_bytes = 0;
+};
 
 /// Section sizes of one step, for reports.
 struct StepSizes {
@@ -84,11 +96,15 @@ public:
     /// Step k as a zero-copy view; its sections are validated on the first call (thread-safe).
     /// Throws Error(path, ...) if T is not the file's type, k is out of range, or the step is bad.
     template <typename T> Octree<T> step(uint32_t k) const;
-    /// Sizes of step k (validates it first, like step()).
+    /// Sizes of step k (validates it first, like step(); under Verify::Touched it reads every node).
     StepSizes step_sizes(uint32_t k) const;
+    /// The mode in force: Touched falls back to Full when the fault handler has no free slot.
+    Verify verify() const;
+    std::optional<TouchStats> touch_stats() const;   ///< Verify::Touched only
     /// Throws Error(path, ...) (bad input) if the file's size or modification time differs from
     /// when it was opened: another program rewrote it in place, so what was read from the
-    /// mapping since is not what was validated (issue 18; policy in src/util/mapping_guard.h).
+    /// mapping since is not what was validated (issue 18; policy in src/util/mapping_guard.h);
+    /// or, under Verify::Touched, if a node read since failed its checks (named in the message).
     /// Tools call it before publishing anything computed from the file.
     void check_unchanged() const;
     /// Unmaps this process's copies of the file's pages (madvise MADV_DONTNEED on the read-only

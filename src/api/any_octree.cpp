@@ -53,13 +53,14 @@ public:
         sizes_.nodes_per_depth = data_->stats.nodes_per_depth;
         sizes_.scalar_leaves_per_depth = data_->stats.scalar_leaves_per_depth;
     }
-    /// A file step: the view points into the mapping, which the base's `file` keeps alive.
-    TypedOctree(const Octree<T>& tree, StepSizes sizes) : tree_(tree), sizes_(std::move(sizes)) {}
+    /// A file step: the view points into the mapping, which the base's `file` keeps alive; its
+    /// sizes are asked of the file when wanted (under Verify::Touched that reads every node).
+    TypedOctree(const Octree<T>& tree, uint32_t step) : tree_(tree), step_(step) {}
 
     ScalarType type() const override { return scalar_type_of<T>(); }
     Dims dims() const override { return tree_.dims(); }
     int dmax() const override { return tree_.dmax(); }
-    StepSizes sizes() const override { return sizes_; }
+    StepSizes sizes() const override { return data_ ? sizes_ : file->step_sizes(step_); }
 
     std::optional<std::array<double, 2>> value_range() const override {
         // The root is always stored (dmax >= 2), and its children's exact range together
@@ -103,7 +104,8 @@ public:
 private:
     std::optional<OctreeData<T>> data_;   // empty for a file step
     Octree<T> tree_;
-    StepSizes sizes_;
+    StepSizes sizes_;     // a built octree's
+    uint32_t step_ = 0;   // a file step's
 };
 
 template <typename T>
@@ -149,7 +151,7 @@ AnyOctree AnyOctree::step(std::shared_ptr<const OctFile> file, uint32_t k) {
     std::shared_ptr<Impl> impl = dispatch_scalar_type(info.type, [&](auto tag) -> std::shared_ptr<Impl> {
         using T = decltype(tag);
         const Octree<T> tree = file->step<T>(k);   // validates step k (once per file and step)
-        return std::make_shared<TypedOctree<T>>(tree, file->step_sizes(k));
+        return std::make_shared<TypedOctree<T>>(tree, k);
     });
     impl->placement = info.placement;
     impl->iso_range = info.iso_range;
@@ -170,6 +172,8 @@ Dims AnyOctree::dims() const { return impl_->dims(); }
 const Placement& AnyOctree::placement() const { return impl_->placement; }
 int AnyOctree::dmax() const { return impl_->dmax(); }
 const std::shared_ptr<const OctFile>& AnyOctree::file() const { return impl_->file; }
+
+std::optional<std::array<double, 2>> AnyOctree::value_range() const { return impl_->value_range(); }
 
 AnyOctreeInfo AnyOctree::info() const {
     const OctInfo header = oct_info();

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -87,6 +88,10 @@ const char* kUsage =
     "                            same image)\n"
     "  --isa auto|baseline|avx2  traversal kernel: auto = AVX2 where the CPU has it (default; same image)\n"
     "  --threads N               worker threads, 0 = all cores (default 0)\n"
+    "  --verify auto|full|touched  full: every node and checksum of a step before its first ray; touched:\n"
+    "                            each block of nodes when a ray first reads it, no checksums, same safety\n"
+    "                            (a frame of a huge file reads what it needs); auto: full up to 1 GiB\n"
+    "                            files, touched above (default auto; octiso-info --verify checks it all)\n"
     "  --progress                draw the progress line (bar, ETA) on stderr even when it is not a terminal\n"
     "                            (default: only on a terminal, for a series at once, for one frame after 1 s)\n"
     "  --distribute steps|image|data  under mpirun: frames dealt to free ranks, each frame's tiles shared, or\n"
@@ -99,7 +104,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     const std::string usage = std::string(kUsage) + cli::kLookUsage;
     if (const auto status = cli::answer_help(argv, ranks.rank == 0 ? usage : std::string())) return *status;
     cli::FlagSpec spec{{"-o,--output", "--iso", "--steps", "--depth", "--normal", "--threads", "--root-finder", "--iterations", "--spp", "--lod",
-                        "--shading", "--background", "--traversal", "--isa", "--debug-pixel", "--distribute"},
+                        "--shading", "--background", "--traversal", "--isa", "--debug-pixel", "--distribute", "--verify"},
                        {"--colour"},
                        {"--no-embree", "--json", "--progress"}};
     cli::CameraFlags::declare(spec);
@@ -118,6 +123,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     const auto traversal_text = args.value("--traversal"), isa_text = args.value("--isa");
     const auto debug_pixel = args.value("--debug-pixel");
     const auto distribute_text = args.value("--distribute");
+    const auto verify_text = args.value("--verify");
     const cli::LookFlags look_flags = cli::LookFlags::take(args);
     const std::vector<std::string>& inputs = args.positional();
     if (inputs.size() != 1) throw Error("octiso-render", "expected exactly one FILE.oct (octiso-render --help lists every flag)");
@@ -182,8 +188,24 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     if (deferred) trace_options.want_colour = false, trace_options.want_depth = trace_options.want_normal = true;
     if (look_flags.clip_cap) trace_options.want_depth = true;
 
+    // Issue 13: checking every node of a 30 GB file before the first ray costs minutes and
+    // leaves it all resident; from 1 GiB up the nodes are checked as rays reach them. Below,
+    // the whole check takes under a second, and it also catches what Touched cannot (checksums).
+    constexpr uint64_t kTouchedFromBytes = uint64_t(1) << 30;
+    Verify verify = Verify::Full;
+    if (!verify_text || *verify_text == "auto") {
+        std::error_code ec;
+        const auto size = std::filesystem::file_size(inputs[0], ec);
+        verify = !ec && size > kTouchedFromBytes ? Verify::Touched : Verify::Full;
+    } else if (*verify_text == "touched") {
+        verify = Verify::Touched;
+    } else if (*verify_text != "full") {
+        throw Error("--verify", "expected auto, full or touched, found '" + *verify_text + "'");
+    }
     // Everything about the outputs is checked before the first frame is rendered.
-    const auto file = std::make_shared<const OctFile>(OctFile::open(inputs[0]));
+    const auto open_start = std::chrono::steady_clock::now();
+    std::optional<double> open_to_first_frame;   // seconds from open to the first frame traced
+    const auto file = std::make_shared<const OctFile>(OctFile::open(inputs[0], verify));
     const OctInfo& info = file->info();
     // CONVENTIONS 2b: --iso is given in real values; the tree and the renderer hold stored ones.
     const std::vector<double> real_isovalues = options.isovalues;
@@ -250,8 +272,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     std::optional<std::array<double, 2>> data_range;
     for (long long k = first; k <= last; ++k)
         if (!split_validation || (k - first) % ranks.size == ranks.rank)
-            if (const auto r = AnyOctree::step(file, uint32_t(k)).info().value_range)
+            if (const auto r = AnyOctree::step(file, uint32_t(k)).value_range())
                 data_range = data_range ? std::array<double, 2>{std::min((*data_range)[0], (*r)[0]), std::max((*data_range)[1], (*r)[1])} : *r;
+    file->check_unchanged();   // the ranges came from root nodes: under --verify touched, checked ones
     const auto refuse_outside_range = [&]() -> int {
         if (data_range) data_range = info.value_scale.real_range(*data_range);
         if (data_range)
@@ -375,6 +398,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         // The whole frame: every sample traced and shaded (record.seconds: the tile loops only).
         record.frame_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         record.hits = frame.stats.hits;
+        if (!open_to_first_frame) open_to_first_frame = std::chrono::duration<double>(std::chrono::steady_clock::now() - open_start).count();
         file->check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
         if (root || !split_frames) {
             if (out_path) write_colour_image(name_for(out_path, "-o", job.index), frame);
@@ -429,6 +453,12 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         j.field("traversal", std::string(options.traversal == Traversal::packets ? "packets" : "single"));
         j.field("isa", std::string(resolve_isa(options.isa) == Isa::avx2 ? "avx2" : "baseline"));
         j.field("lod", options.lod);
+        j.field("verify", std::string(file->verify() == Verify::Touched ? "touched" : "full"));
+        if (const auto t = file->touch_stats())
+            j.key("touched_blocks").begin_object().field("blocks", (long long)t->blocks).field("checked", (long long)t->checked)
+                .field("block_bytes", (long long)t->block_bytes).end_object();
+        if (open_to_first_frame) j.field("open_to_first_frame_seconds", *open_to_first_frame);
+        j.field("file_resident_bytes", (long long)(rank_count > 1 ? resident : mapped_resident_bytes(inputs[0])));
         j.field("spp", spp).field("shading", deferred ? (shading.model == ShadingModel::kit ? "kit" : "headlight (deferred)") : "headlight");
         cli::write_look_json(j, look_flags);   // issue 17 item 7
         j.field("ranks", rank_count).field("distribute", std::string(distribute_name(distribute)));

@@ -1,7 +1,8 @@
 // OctFile: maps a .oct file read-only, validates header and section table at open (cheap, all of
 // it, without touching any step's bytes), and each step's sections on first use (padding,
 // checksums, then every index; validate.cpp), so a mapped series only becomes resident for the
-// steps used. Steps are handed out as zero-copy Octree<T> views into the mapping.
+// steps used. Steps are handed out as zero-copy Octree<T> views into the mapping. Verify::Touched
+// leaves the nodes to format::TouchValidator, which checks each block when it is first read.
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include <unistd.h>
 
 #include "format/oct_layout.h"
+#include "format/touch_validation.h"
 #include "format/validate.h"
 #include "util/mapping_guard.h"
 #include "octiso/error.h"
@@ -29,6 +31,8 @@ namespace {
 struct StepState {
     std::once_flag once;
     StepSizes sizes;   // written once inside call_once, read-only afterwards
+    std::once_flag full_once;   // Verify::Touched: step_sizes() counts every node once
+    StepSizes full_sizes;
 };
 
 std::string num(uint64_t v) { return std::to_string(v); }
@@ -57,8 +61,10 @@ struct OctFile::Impl {
     OctInfo info;
     const SectionEntry* table = nullptr;   // step_count * dmax entries, (step, depth) order
     std::unique_ptr<StepState[]> steps;
+    std::unique_ptr<format::TouchValidator> touch;   // Verify::Touched only
 
     ~Impl() {
+        touch.reset();   // clears its fault resolver before the slot and the mapping go
         io::unregister_mapping(guard_slot);
         if (base) ::munmap(const_cast<std::byte*>(base), size_t(bytes));
         if (fd >= 0) ::close(fd);
@@ -98,15 +104,39 @@ struct OctFile::Impl {
             fail("step " + num(k) + " does not exist (expected 0 .. " + num(info.step_count - 1) + ")");
         StepState& st = steps[k];
         std::call_once(st.once, [&] {
+            if (touch)
+                if (const auto problem = touch->failure()) fail(*problem);   // a zeroed block may hold the table
             check_step_padding(k);
             if (verify == Verify::Full)
                 for (int d = 0; d < info.dmax; ++d) format::verify_section_checksum(path, base, section(k, d));
             st.sizes = dispatch_scalar_type(info.type, [&](auto t) {
                 using T = decltype(t);
-                return format::validate_tree<T>(path, arrays<T>(k), k);
+                // Touched: the counts now, each node when a block of them is first read.
+                return verify == Verify::Touched ? format::validate_counts<T>(path, arrays<T>(k), k)
+                                                 : format::validate_tree<T>(path, arrays<T>(k), k);
             });
         });
         return st.sizes;
+    }
+
+    /// The sizes of every level (Verify::Touched counted no node at first use; this does, once).
+    const StepSizes& full_sizes(uint32_t k) const {
+        const StepSizes& sizes = ensure_valid(k);
+        if (verify != Verify::Touched) return sizes;
+        StepState& st = steps[k];
+        std::call_once(st.full_once, [&] {
+            try {
+                st.full_sizes = dispatch_scalar_type(info.type, [&](auto t) {
+                    using T = decltype(t);
+                    return format::validate_tree<T>(path, arrays<T>(k), k);
+                });
+            } catch (const Error&) {
+                // A block zeroed for a bad node breaks the rules across nodes too: name the node.
+                if (const auto problem = touch->failure()) fail(*problem);
+                throw;
+            }
+        });
+        return st.full_sizes;
     }
 };
 
@@ -301,6 +331,16 @@ OctFile OctFile::open(const std::string& path, Verify verify) {
     m.check_header();
     m.check_table();
     m.steps = std::make_unique<StepState[]>(m.info.step_count);
+    if (verify == Verify::Touched) {
+        if (m.guard_slot < 0) {
+            m.verify = Verify::Full;   // no fault handler slot left: check everything at first use
+        } else {
+            FileHeader h;
+            std::memcpy(&h, m.base, sizeof h);
+            m.touch = std::make_unique<format::TouchValidator>(path, m.fd, m.base, m.bytes, m.info, h.section_table_offset,
+                                                               m.guard_slot);
+        }
+    }
     return f;
 }
 
@@ -318,7 +358,14 @@ template <typename T> Octree<T> OctFile::step(uint32_t k) const {
     return Octree<T>(a);
 }
 
-StepSizes OctFile::step_sizes(uint32_t k) const { return impl_->ensure_valid(k); }
+StepSizes OctFile::step_sizes(uint32_t k) const { return impl_->full_sizes(k); }
+
+Verify OctFile::verify() const { return impl_->verify; }
+
+std::optional<TouchStats> OctFile::touch_stats() const {
+    if (!impl_->touch) return std::nullopt;
+    return TouchStats{impl_->touch->blocks(), impl_->touch->blocks_checked(), impl_->touch->block_bytes()};
+}
 
 void OctFile::release_resident_pages() const {
     // Read-only and never written: dropping the pages loses nothing; a failure only costs memory.
@@ -331,6 +378,8 @@ void OctFile::check_unchanged() const {
     if (::fstat(m.fd, &st) != 0 || st.st_size != m.opened.st_size || st.st_mtim.tv_sec != m.opened.st_mtim.tv_sec ||
         st.st_mtim.tv_nsec != m.opened.st_mtim.tv_nsec)
         m.fail("the file changed while it was being read (rewritten in place by another program); nothing was written");
+    if (m.touch)
+        if (const auto problem = m.touch->failure()) m.fail(*problem + "; nothing was written");
 }
 
 #define OCTISO_INSTANTIATE(T) template Octree<T> OctFile::step<T>(uint32_t) const;

@@ -57,22 +57,21 @@ struct ChunkResult {
 
 constexpr uint64_t kChunk = 1u << 15;
 
-/// The node's own fields (formats 3 and 4, octree.h): the cap width where caps lie below, zero high
-/// offset bits and zero width elsewhere, ordered finite bounds, lattice samples inside their ranges. Empty when they are fine.
-template <typename T> std::string field_problem(const InteriorNode<T>& n, bool caps_below) {
+}  // namespace
+
+// The node's own fields (formats 3 and 4, octree.h): the cap width where caps lie below, zero high
+// offset bits and zero width elsewhere, ordered finite bounds, lattice samples inside their ranges;
+// then its children inside the level below. Allocation-free: the touch validator runs it in a
+// fault handler (touch_validation.h); node_problem() words the same checks for a message.
+template <typename T> NodeDefect node_defect(const InteriorNode<T>& n, bool caps_below, uint64_t next_count) noexcept {
     if (caps_below) {
-        if (n.cap_bits != kWholeCapBits<T> && n.cap_bits > kMaxDeltaBits<T>)
-            return "cap_bits out of range (expected 0 .. " + std::to_string(kMaxDeltaBits<T>) + " or " +
-                   std::to_string(kWholeCapBits<T>) + ", found " + std::to_string(n.cap_bits) + ")";
+        if (n.cap_bits != kWholeCapBits<T> && n.cap_bits > kMaxDeltaBits<T>) return NodeDefect::cap_bits;
     } else if (n.cap_bits != 0 || n.child_start_hi != 0) {
-        return "cap_bits and child_start_hi must be zero above the cap parents (found " + std::to_string(n.cap_bits) +
-               " and " + std::to_string(n.child_start_hi) + ")";
+        return NodeDefect::high_fields;
     }
     if constexpr (sizeof(T) > 1) {
         const double lo = double(n.bounds.lo), hi = double(n.bounds.hi);
-        if (!(std::isfinite(lo) && std::isfinite(hi) && lo <= hi))
-            return "bounds range is not finite and ordered (found lo " + std::to_string(lo) + ", hi " +
-                   std::to_string(hi) + ")";
+        if (!(std::isfinite(lo) && std::isfinite(hi) && lo <= hi)) return NodeDefect::bounds;
     }
     // Format 4: a stored interior child's scalar is the voxel at its lower corner, a corner of
     // one of its data cells, so it lies in the child's range whenever that range is not empty.
@@ -81,17 +80,53 @@ template <typename T> std::string field_problem(const InteriorNode<T>& n, bool c
         for (int c = 0; c < 8; ++c) {
             if (!((n.child_mask >> c) & 1u) || n.bounds.empty(c)) continue;
             const double v = double(n.scalar[c]);
+            if (!(n.bounds.lower(c) <= v && v <= n.bounds.upper(c))) return NodeDefect::lattice_sample;
+        }
+    // Compared without adding: first_child() is at most 2^48 and the span at most 8 x 64.
+    const uint64_t start = n.first_child(), span = n.children_span(caps_below);
+    if (start > next_count || span > next_count - start) return NodeDefect::children_past_end;
+    return NodeDefect::none;
+}
+
+template <typename T> std::string node_problem(const InteriorNode<T>& n, bool caps_below, uint64_t next_count) {
+    switch (node_defect(n, caps_below, next_count)) {
+    case NodeDefect::none: return {};
+    case NodeDefect::cap_bits:
+        return "cap_bits out of range (expected 0 .. " + std::to_string(kMaxDeltaBits<T>) + " or " +
+               std::to_string(kWholeCapBits<T>) + ", found " + std::to_string(n.cap_bits) + ")";
+    case NodeDefect::high_fields:
+        return "cap_bits and child_start_hi must be zero above the cap parents (found " + std::to_string(n.cap_bits) +
+               " and " + std::to_string(n.child_start_hi) + ")";
+    case NodeDefect::bounds:
+        if constexpr (sizeof(T) > 1)
+            return "bounds range is not finite and ordered (found lo " + std::to_string(double(n.bounds.lo)) + ", hi " +
+                   std::to_string(double(n.bounds.hi)) + ")";
+        return "bounds range is not finite and ordered";
+    case NodeDefect::lattice_sample:
+        for (int c = 0; c < 8; ++c) {
+            if (!((n.child_mask >> c) & 1u) || n.bounds.empty(c)) continue;
+            const double v = double(n.scalar[c]);
             if (!(n.bounds.lower(c) <= v && v <= n.bounds.upper(c)))
                 return "child " + std::to_string(c) + ": its lattice sample (scalar) lies outside its range (expected " +
                        std::to_string(n.bounds.lower(c)) + " .. " + std::to_string(n.bounds.upper(c)) + ", found " +
                        std::to_string(v) + ")";
         }
+        return "a lattice sample lies outside its range";
+    case NodeDefect::children_past_end: {
+        const uint64_t start = n.first_child(), span = n.children_span(caps_below);
+        const char* what = caps_below ? "first_child + popcount(child_mask) x cap_bits" : "child_start + popcount(child_mask)";
+        return std::string(what) + " runs past the " + std::to_string(next_count) + " " +
+               (caps_below ? "bytes of caps" : "nodes") + " below (expected <= " + std::to_string(next_count) +
+               ", found " + std::to_string(start) + " + " + std::to_string(span) + " = " + std::to_string(start + span) + ")";
+    }
+    }
     return {};
 }
 
+namespace {
+
 template <typename T>
-ChunkResult check_chunk(const InteriorNode<T>* nodes, uint64_t begin, uint64_t end, uint64_t next_count,
-                        const char* next_name, bool caps_below) {
+ChunkResult check_chunk(const InteriorNode<T>* nodes, uint64_t begin, uint64_t end, uint64_t next_count, bool caps_below) {
     ChunkResult r;
     uint64_t expected_start = 0;   // where the next node with children must start (after the first)
     for (uint64_t i = begin; i < end; ++i) {
@@ -103,15 +138,8 @@ ChunkResult check_chunk(const InteriorNode<T>* nodes, uint64_t begin, uint64_t e
             r.bad_node = i;
             r.problem = std::move(problem);
         };
-        if (std::string p = field_problem(n, caps_below); !p.empty()) {
-            fail(std::move(p));
-            return r;
-        }
-        if (start + span > next_count) {
-            const char* what = caps_below ? "first_child + popcount(child_mask) x cap_bits" : "child_start + popcount(child_mask)";
-            fail(std::string(what) + " runs past the " + std::to_string(next_count) + " " + next_name +
-                 " below (expected <= " + std::to_string(next_count) + ", found " + std::to_string(start) + " + " +
-                 std::to_string(span) + " = " + std::to_string(start + span) + ")");
+        if (node_defect(n, caps_below, next_count) != NodeDefect::none) {
+            fail(node_problem(n, caps_below, next_count));
             return r;
         }
         if (pc != 0) {
@@ -145,7 +173,7 @@ void verify_section_checksum(const std::string& subject, const std::byte* base, 
                                  hex(found) + ")");
 }
 
-template <typename T> StepSizes validate_tree(const std::string& subject, const OctreeArrays<T>& a, uint32_t step) {
+template <typename T> StepSizes validate_counts(const std::string& subject, const OctreeArrays<T>& a, uint32_t step) {
     const int dmax = a.dmax;
     if (dmax < 2 || dmax >= kMaxDepth)
         throw Error(subject, "step " + std::to_string(step) + ": dmax out of range (expected 2 .. " +
@@ -166,17 +194,35 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
     if (a.cap_bytes > kMaxCapByteOffset)
         throw Error(subject, where(step, dmax - 1, dmax) + ": too many bytes for 48-bit cap offsets (expected <= " +
                                  std::to_string(kMaxCapByteOffset) + ", found " + std::to_string(a.cap_bytes) + ")");
+    if (a.caps == nullptr) throw Error(subject, where(step, dmax - 1, dmax) + ": no cap level");
+    for (uint64_t i = 0; i < kCapReadSlack; ++i)
+        if (a.caps[a.cap_bytes + i] != 0)
+            throw Error(subject, where(step, dmax - 1, dmax) + ": the " + std::to_string(kCapReadSlack) +
+                                     " bytes after the last cap are not zero");
     StepSizes sizes;
     sizes.nodes_per_depth.assign(size_t(dmax), 0);
     sizes.scalar_leaves_per_depth.assign(size_t(dmax), 0);
+    for (int d = 0; d <= dmax - 2; ++d) {
+        const uint64_t count = a.node_count[size_t(d)];
+        if (count != 0 && a.nodes[size_t(d)] == nullptr)
+            throw Error(subject, where(step, d, dmax) + ": " + std::to_string(count) + " nodes but no data");
+        sizes.nodes_per_depth[size_t(d)] = count;
+        sizes.interior_bytes += count * sizeof(InteriorNode<T>);
+        sizes.minmax_bytes += count * sizeof(ChildBounds<T>);
+    }
+    sizes.cap_bytes = a.cap_bytes;
+    return sizes;
+}
+
+template <typename T> StepSizes validate_tree(const std::string& subject, const OctreeArrays<T>& a, uint32_t step) {
+    const int dmax = a.dmax;
+    StepSizes sizes = validate_counts(subject, a, step);
 
     for (int d = 0; d <= dmax - 2; ++d) {
         const uint64_t count = a.node_count[size_t(d)];
         const bool next_is_caps = d + 1 == dmax - 1;
         const uint64_t next_count = next_is_caps ? a.cap_bytes : a.node_count[size_t(d + 1)];
         const InteriorNode<T>* nodes = a.nodes[size_t(d)];
-        if (count != 0 && nodes == nullptr)
-            throw Error(subject, where(step, d, dmax) + ": " + std::to_string(count) + " nodes but no data");
 
         // 2. Local checks per chunk in parallel, each chunk stopping at its first bad node.
         const uint64_t n_chunks = (count + kChunk - 1) / kChunk;
@@ -185,7 +231,7 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
         tbb::parallel_for(uint64_t(0), n_chunks, [&](uint64_t c) {
             const uint64_t begin = c * kChunk;
             const uint64_t end = std::min(count, begin + kChunk);
-            chunks[c] = check_chunk(nodes, begin, end, next_count, next_name, next_is_caps);
+            chunks[c] = check_chunk(nodes, begin, end, next_count, next_is_caps);
         });
 
         // 3. Stitch: each chunk's first children start where the previous chunks' children end;
@@ -207,23 +253,17 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
             throw Error(subject, where(step, d + 1, dmax) + ": the parents' child masks do not cover the level exactly (expected " +
                                      std::to_string(covered) + " " + next_name + ", found " + std::to_string(next_count) +
                                      ")");
-        sizes.nodes_per_depth[size_t(d)] = count;
         sizes.scalar_leaves_per_depth[size_t(d)] = leaves;
-        sizes.interior_bytes += count * sizeof(InteriorNode<T>);
-        sizes.minmax_bytes += count * sizeof(ChildBounds<T>);
         if (next_is_caps) sizes.nodes_per_depth[size_t(dmax - 1)] = stored;
     }
-    if (a.caps == nullptr) throw Error(subject, where(step, dmax - 1, dmax) + ": no cap level");
-    for (uint64_t i = 0; i < kCapReadSlack; ++i)
-        if (a.caps[a.cap_bytes + i] != 0)
-            throw Error(subject, where(step, dmax - 1, dmax) + ": the " + std::to_string(kCapReadSlack) +
-                                     " bytes after the last cap are not zero");
-    sizes.cap_bytes = a.cap_bytes;
     return sizes;
 }
 
-#define OCTISO_INSTANTIATE(T) \
-    template StepSizes validate_tree<T>(const std::string&, const OctreeArrays<T>&, uint32_t);
+#define OCTISO_INSTANTIATE(T)                                                                                 \
+    template StepSizes validate_tree<T>(const std::string&, const OctreeArrays<T>&, uint32_t);                \
+    template StepSizes validate_counts<T>(const std::string&, const OctreeArrays<T>&, uint32_t);              \
+    template NodeDefect node_defect<T>(const InteriorNode<T>&, bool, uint64_t) noexcept;                     \
+    template std::string node_problem<T>(const InteriorNode<T>&, bool, uint64_t);
 OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
 #undef OCTISO_INSTANTIATE
 

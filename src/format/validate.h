@@ -27,4 +27,17 @@ void verify_section_checksum(const std::string& subject, const std::byte* base, 
 /// expected vs found numbers. Thread-safe (reads only).
 template <typename T> StepSizes validate_tree(const std::string& subject, const OctreeArrays<T>& a, uint32_t step);
 
+/// Step 1 of validate_tree alone, O(dmax): the counts, and the cap level's zero slack. Returns the
+/// sizes that follow from the counts (no scalar leaves, no cap count: those need every node).
+template <typename T> StepSizes validate_counts(const std::string& subject, const OctreeArrays<T>& a, uint32_t step);
+
+/// What is wrong with one interior node on its own (its fields, and its children inside the
+/// `next_count` nodes, or bytes of caps when `caps_below`, of the level below): the local checks
+/// of validate_tree step 2, which are all that memory safety needs (a renderer reads nothing but
+/// what an in-range index or cap offset points at). No allocation: safe in a fault handler.
+enum class NodeDefect : uint8_t { none, cap_bits, high_fields, bounds, lattice_sample, children_past_end };
+template <typename T> NodeDefect node_defect(const InteriorNode<T>& n, bool caps_below, uint64_t next_count) noexcept;
+/// The same checks in words, as validate_tree reports them (empty when the node is fine).
+template <typename T> std::string node_problem(const InteriorNode<T>& n, bool caps_below, uint64_t next_count);
+
 }  // namespace octiso::format

@@ -1,5 +1,6 @@
 // The fault handler behind mapping_guard.h. It only uses async-signal-safe calls (fstat, write,
-// sigaction, _exit) and memory that exists before any fault: a fixed table of slots.
+// sigaction, _exit) and memory that exists before any fault: a fixed table of slots. A slot's
+// resolver (the touch validator) keeps to the same rule.
 #include "util/mapping_guard.h"
 
 #include <atomic>
@@ -10,6 +11,7 @@
 #include <mutex>
 
 #include <sys/file.h>
+#include <ucontext.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -30,6 +32,8 @@ struct Slot {
     int fd = -1;
     off_t size = 0;
     struct timespec mtime {};
+    std::atomic<FaultResolver> resolver{nullptr};
+    void* resolver_context = nullptr;   // written before resolver is stored (release)
     char path[PATH_MAX];
 };
 Slot g_slots[kSlots];
@@ -58,7 +62,17 @@ void put(char* buf, size_t& n, size_t cap, const char* text) {
     ::_exit(2);
 }
 
-extern "C" void on_fault(int sig, siginfo_t* info, void*) {
+/// Whether the faulting access was a store: x86-64 puts the page-fault error code in REG_ERR
+/// (bit 1: write). Elsewhere unknown, taken as a load.
+bool fault_was_write([[maybe_unused]] void* ucontext) {
+#if defined(__x86_64__) && defined(REG_ERR)
+    return ucontext && (static_cast<ucontext_t*>(ucontext)->uc_mcontext.gregs[REG_ERR] & 2) != 0;
+#else
+    return false;
+#endif
+}
+
+extern "C" void on_fault(int sig, siginfo_t* info, void* ucontext) {
     const char* addr = static_cast<const char*>(info ? info->si_addr : nullptr);
     // 1. A SIGBUS inside a mapping: the pages behind it are gone (the file shrank).
     if (sig == SIGBUS)
@@ -68,7 +82,13 @@ extern "C" void on_fault(int sig, siginfo_t* info, void*) {
     //    the ones the checks saw (lying indices can send a read anywhere).
     for (const Slot& s : g_slots)
         if (s.live.load(std::memory_order_acquire) && changed_since_mapped(s)) report_and_exit(s);
-    // 3. Not ours: restore the previous action; returning re-executes the fault under it.
+    // 3. A protected block of a mapping whose resolver checks it and makes it readable.
+    if (sig == SIGSEGV)
+        for (Slot& s : g_slots)
+            if (s.live.load(std::memory_order_acquire) && addr >= s.base && addr < s.base + s.bytes)
+                if (FaultResolver r = s.resolver.load(std::memory_order_acquire))
+                    if (r(s.resolver_context, addr, fault_was_write(ucontext))) return;
+    // 4. Not ours: restore the previous action; returning re-executes the fault under it.
     ::sigaction(sig, sig == SIGBUS ? &g_prev_bus : &g_prev_segv, nullptr);
 }
 
@@ -110,6 +130,7 @@ int register_mapping(const void* base, uint64_t bytes, int fd, const std::string
         const size_t n = path.size() < sizeof s.path - 1 ? path.size() : sizeof s.path - 1;
         std::memcpy(s.path, path.data(), n);
         s.path[n] = '\0';
+        s.resolver.store(nullptr, std::memory_order_relaxed);
         s.live.store(true, std::memory_order_release);
         return i;
     }
@@ -117,7 +138,16 @@ int register_mapping(const void* base, uint64_t bytes, int fd, const std::string
 }
 
 void unregister_mapping(int slot) {
-    if (slot >= 0) g_slots[slot].live.store(false, std::memory_order_release);
+    if (slot < 0) return;
+    g_slots[slot].resolver.store(nullptr, std::memory_order_release);
+    g_slots[slot].live.store(false, std::memory_order_release);
+}
+
+void set_fault_resolver(int slot, FaultResolver resolver, void* context) {
+    if (slot < 0) return;
+    g_slots[slot].resolver.store(nullptr, std::memory_order_release);
+    g_slots[slot].resolver_context = context;
+    g_slots[slot].resolver.store(resolver, std::memory_order_release);
 }
 
 }  // namespace octiso::io

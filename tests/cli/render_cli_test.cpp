@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "format/oct_test_util.h"
 #include "test_util/run_shell.h"
 #include "octiso/image.h"
 #include "test_util/scratch_dir.h"
@@ -126,6 +127,44 @@ TEST_F(RenderCli, CorruptFileIsRejectedCleanly) {
     EXPECT_EQ(run("octiso-render", "'" + bad + "' --iso 5 -o '" + out.file("x.png") + "'", nullptr, &err), 2);
     EXPECT_NE(err.find("bad.oct"), std::string::npos) << err;
     EXPECT_FALSE(fs::exists(out.file("x.png")));
+}
+
+// Issue 13: --verify touched checks nodes as rays reach them (format/touch_validation.h). The
+// image is the full check's byte for byte, with threads faulting on blocks together; a bad node
+// a frame reads ends the run with the full check's message and no output.
+TEST_F(RenderCli, VerifyTouchedGivesTheSameImageAndRefusesABadNode) {
+    TempDir out;
+    const std::string big = out.file("plume.oct");
+    ASSERT_EQ(run("octiso-convert", "--synthetic plume:256 -o '" + big + "'"), 0);
+    ASSERT_GT(fs::file_size(big), uint64_t(4) << 20) << "the file must span several blocks";
+    std::string json;
+    const std::string common = " --iso 40.5 --size 96x96 --threads 2 --json ";
+    ASSERT_EQ(run("octiso-render", "'" + big + "'" + common + "--verify full -o '" + out.file("full.png") + "'"), 0);
+    ASSERT_EQ(run("octiso-render", "'" + big + "'" + common + "--verify touched -o '" + out.file("touched.png") + "'", &json), 0);
+    EXPECT_EQ(read_bytes(out.file("full.png")), read_bytes(out.file("touched.png")));
+    EXPECT_NE(json.find("\"verify\":\"touched\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"touched_blocks\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"open_to_first_frame_seconds\""), std::string::npos) << json;
+
+    OctBytes b(big);
+    auto root = b.node<uint8_t>(0, 0, 0);
+    root.child_start = 0xffffffffu;
+    b.set_node(0, 0, 0, root);
+    b.rechecksum();
+    const std::string bad = out.file("bad.oct");
+    b.save(bad);
+    for (const char* mode : {"full", "touched"}) {
+        SCOPED_TRACE(mode);
+        std::string err;
+        EXPECT_EQ(run("octiso-render", "'" + bad + "'" + common + "--verify " + mode + " -o '" + out.file("x.png") + "'", nullptr, &err), 2);
+        EXPECT_NE(err.find("bad.oct: step 0, depth 0 (interior nodes), node 0: child_start + popcount(child_mask) runs past"),
+                  std::string::npos) << err;
+        EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+        EXPECT_FALSE(fs::exists(out.file("x.png")));
+    }
+    std::string err;
+    EXPECT_EQ(run("octiso-render", "'" + big + "' --iso 40.5 --verify some -o '" + out.file("x.png") + "'", nullptr, &err), 2);
+    EXPECT_NE(err.find("--verify: expected auto, full or touched"), std::string::npos) << err;
 }
 
 }  // namespace
