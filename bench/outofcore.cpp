@@ -14,6 +14,9 @@
 #include <iostream>
 #include <vector>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include "bench/bench.h"
 #include "bench/tools.h"
 #include "octiso/error.h"
@@ -84,6 +87,25 @@ struct PathRow {
 
 double mib(uint64_t b) { return double(b) / 1048576.0; }
 
+/// One frame of the converted file from a cold page cache: what opening and validating cost
+/// before the first pixel, and what the frame left resident (issue 13, --verify).
+struct RenderRow {
+    std::string verify, view;
+    double open_to_first_frame = 0, frame_seconds = 0;
+    uint64_t resident = 0, blocks = 0, checked = 0;
+    uint64_t hits = 0;
+};
+
+/// Drops the file's pages from the page cache (clean pages of a file nobody maps: the kernel
+/// honours it without root), so that every render starts cold.
+void evict(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY);
+    if (fd < 0) return;
+    ::fdatasync(fd);
+    ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+    ::close(fd);
+}
+
 int run_outofcore(cli::Args& args) {
     if (args.flag("--help")) {
         std::cout << kOutOfCoreUsage << "\n";
@@ -142,6 +164,30 @@ int run_outofcore(cli::Args& args) {
     }
     const std::string a = dir + "/outofcore_" + tag + "_streamed.oct", b = dir + "/outofcore_" + tag + "_in_memory.oct";
     const bool identical = same_files(a, b);
+
+    // 3. A 512^2 frame of the file, afar (the whole data) and close up (zoom 8: a corner of it),
+    //    under --verify full and touched, each from a cold cache, interleaved.
+    std::vector<RenderRow> renders;
+    const std::string image = dir + "/outofcore_" + tag + "_frame.png";
+    for (const char* view : {"afar", "close"})
+        for (const char* verify : {"full", "touched"}) {
+            evict(a);
+            std::vector<std::string> args{a, "--iso", "98", "--size", quick ? "64x64" : "512x512", "--verify", verify, "--json", "-o", image};
+            if (std::string(view) == "close") args.insert(args.end(), {"--zoom", "8"});
+            if (threads_flag) args.insert(args.end(), {"--threads", *threads_flag});
+            const std::string json = run_tool("octiso-render", args);
+            RenderRow r{verify, view};
+            r.open_to_first_frame = json_number(json, "open_to_first_frame_seconds");
+            r.frame_seconds = json_number(json, "frame_seconds");
+            r.resident = uint64_t(json_number(json, "file_resident_bytes"));
+            r.hits = uint64_t(json_number(json, "hits"));
+            if (std::string(verify) == "touched") {
+                r.blocks = uint64_t(json_number(json, "blocks"));
+                r.checked = uint64_t(json_number(json, "checked"));
+            }
+            renders.push_back(r);
+        }
+    std::filesystem::remove(image, ec);
     std::filesystem::remove(a, ec);
     std::filesystem::remove(b, ec);
     if (!keep) std::filesystem::remove(input, ec);
@@ -158,6 +204,13 @@ int run_outofcore(cli::Args& args) {
     table.print(std::cout);
     std::cout << "the two .oct files are " << (identical ? "identical, byte for byte" : "DIFFERENT") << "; throughput "
               << fmt(100.0 * rows[0].mvoxels_per_second / rows[1].mvoxels_per_second, 1) << " % of in-memory\n";
+    std::cout << "one frame of the " << fmt(mib(rows[0].file_bytes), 1) << " MiB file, cold page cache:\n";
+    Table frames({"view", "--verify", "open to first frame s", "frame s", "file resident MiB", "% of file", "blocks checked", "hits"});
+    for (const RenderRow& r : renders)
+        frames.add({r.view, r.verify, fmt(r.open_to_first_frame, 2), fmt(r.frame_seconds, 2), fmt(mib(r.resident), 1),
+                    fmt(100.0 * double(r.resident) / double(std::max<uint64_t>(1, rows[0].file_bytes)), 1),
+                    r.verify == "touched" ? std::to_string(r.checked) + " / " + std::to_string(r.blocks) : "-", std::to_string(r.hits)});
+    frames.print(std::cout);
     const std::string path = write_json(results, quick ? "outofcore" : "outofcore_" + tag, [&](cli::JsonWriter& j) {
         j.field("dims", tag).field("type", std::string("u8")).field("input_bytes", voxels).field("memory", memory);
         j.field("machine", machine_description()).field("identical", identical).field("input_sha256", input_sha);
@@ -167,6 +220,13 @@ int run_outofcore(cli::Args& args) {
             j.field("build_seconds", r.build_seconds).field("mvoxels_per_second", r.mvoxels_per_second);
             j.field("peak_rss_bytes", r.peak_rss).field("bytes_read", r.bytes_read).field("file_bytes", r.file_bytes);
             j.field("spilled_bytes", r.spilled).field("piece_side", r.piece_side).field("lossless", r.lossless).end_object();
+        }
+        j.end_array();
+        j.key("frames").begin_array();
+        for (const RenderRow& r : renders) {
+            j.begin_object().field("view", r.view).field("verify", r.verify).field("open_to_first_frame_seconds", r.open_to_first_frame);
+            j.field("frame_seconds", r.frame_seconds).field("file_resident_bytes", r.resident).field("hits", r.hits);
+            j.field("blocks", r.blocks).field("blocks_checked", r.checked).end_object();
         }
         j.end_array();
     });

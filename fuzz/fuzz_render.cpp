@@ -1,6 +1,8 @@
 // libFuzzer target: whatever .oct loads (after re-checksumming) is rendered at 12x12 with an
 // isovalue taken from the input, colour, depth and normals, through the Embree path and the
-// direct one, at full resolution or with a level of detail (byte 8, bits 1-3: --lod 0 .. 64).
+// direct one, at full resolution or with a level of detail (byte 8, bits 1-3: --lod 0 .. 64),
+// the file validated whole or block by block as the rays read it (bit 4: Verify::Touched; then a
+// defect the frame read must be reported by check_unchanged(), and the frame stay in the file).
 // Every pixel must come out finite (depth: finite or +inf), the normals unit or 0.
 #include <cmath>
 #include <cstdlib>
@@ -19,12 +21,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool embree = data[8] & 1;
     constexpr double kLod[8] = {0, 0.5, 1, 2, 4, 8, 16, 64};
     const double lod = kLod[(data[8] >> 1) & 7];
+    const octiso::Verify verify = (data[8] >> 4) & 1 ? octiso::Verify::Touched : octiso::Verify::Full;
     std::vector<uint8_t> bytes(data + 9, data + size);
     octiso::fuzz::rechecksum(bytes);
     octiso::fuzz::MemFile f(bytes.data(), bytes.size(), "render");
     if (!f.ok() || !std::isfinite(iso)) return 0;
     try {
-        const octiso::OctFile file = octiso::OctFile::open(f.path());
+        const octiso::OctFile file = octiso::OctFile::open(f.path(), verify);
         const octiso::OctInfo& info = file.info();
         octiso::RenderOptions options;
         options.isovalues = {iso};
@@ -40,6 +43,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             using T = decltype(tag);
             octiso::Renderer(file.step<T>(0), info.placement, options, limits).render(camera, frame);
         });
+        file.check_unchanged();   // Touched: a bad node read above is refused here
         for (float t : frame.depth)
             if (std::isnan(t)) std::abort();
         for (size_t p = 0; p + 2 < frame.normal.size(); p += 3) {
