@@ -224,6 +224,7 @@ int run_interactive(cli::Args& args) {
               << machine_description() << "; load average " << fmt(load, 2) << ")\n";
     table.print(std::cout);
     const std::string path = write_json(results, "interactive", [&](cli::JsonWriter& j) {
+        j.begin_object();
         j.field("threads", int64_t(threads)).field("changes", int64_t(changes)).field("machine", machine_description());
         j.field("load_average_1min", load).field("shadows", shadows).field("ao", int64_t(ao));
         j.key("rows").begin_array();
@@ -236,6 +237,7 @@ int run_interactive(cli::Args& args) {
             j.end_object();
         }
         j.end_array();
+        j.end_object();
     });
     std::cout << "wrote " << path << "\n";
     return 0;

@@ -224,7 +224,8 @@ int run_mpi(cli::Args& args) {
                  " grow with the rank count, the gather to rank 0 is the serial part)\n";
 
     const std::string path = write_json(results, quick ? "mpi_quick" : all_parts ? "mpi" : "mpi_series", [&](cli::JsonWriter& j) {
-        j.field("machine", machine_description()).field("plume", n).field("series", series_spec).field("iso", iso);
+        j.begin_object();
+        j.field("machine", machine_description()).field("plume", n).field("series_spec", series_spec).field("iso", iso);
         j.key("modes").begin_array();
         for (const ModeRow& m : modes)
             j.begin_object().field("mode", m.mode).field("ranks", m.ranks).field("threads", m.threads).field("size", m.size)
@@ -238,6 +239,7 @@ int run_mpi(cli::Args& args) {
             j.begin_object().field("ranks", r.ranks).field("rank", r.rank).field("mapped_bytes", r.resident)
                 .field("brick_node_bytes", r.brick).field("file_bytes_over_ranks", r.share).end_object();
         j.end_array();
+        j.end_object();
     });
     std::cout << "wrote " << path << "\n";
     if (!residency_ok) std::cout << "note: a rank mapped more than 110 % of its brick's nodes\n";

@@ -212,6 +212,7 @@ int run_outofcore(cli::Args& args) {
                     r.verify == "touched" ? std::to_string(r.checked) + " / " + std::to_string(r.blocks) : "-", std::to_string(r.hits)});
     frames.print(std::cout);
     const std::string path = write_json(results, quick ? "outofcore" : "outofcore_" + tag, [&](cli::JsonWriter& j) {
+        j.begin_object();
         j.field("dims", tag).field("type", std::string("u8")).field("input_bytes", voxels).field("memory", memory);
         j.field("machine", machine_description()).field("identical", identical).field("input_sha256", input_sha);
         j.key("paths").begin_array();
@@ -229,6 +230,7 @@ int run_outofcore(cli::Args& args) {
             j.field("blocks", r.blocks).field("blocks_checked", r.checked).end_object();
         }
         j.end_array();
+        j.end_object();
     });
     std::cout << "wrote " << path << "\n";
     return identical && rows[0].lossless && rows[1].lossless ? 0 : 1;

@@ -75,6 +75,7 @@ int run_setup(cli::Args& args) {
               << " interleaved calls each (" << machine_description() << ")\n";
     table.print(std::cout);
     const std::string path = write_json(results, "setup", [&](cli::JsonWriter& j) {
+        j.begin_object();
         j.field("dataset", std::string("plume")).field("size", int64_t(n)).field("threads", int64_t(threads));
         j.field("calls", int64_t(calls)).field("machine", machine_description());
         j.key("rows").begin_array();
@@ -84,6 +85,7 @@ int run_setup(cli::Args& args) {
             j.field("kept_renderer_min_us", r.kept_min_us).end_object();
         }
         j.end_array();
+        j.end_object();
     });
     std::cout << "wrote " << path << "\n";
     return 0;
