@@ -96,8 +96,9 @@ struct RenderRow {
     uint64_t hits = 0;
 };
 
-/// Drops the file's pages from the page cache (clean pages of a file nobody maps: the kernel
-/// honours it without root), so that every render starts cold.
+/// Drops the file's pages from the page cache, so that every render starts cold: written back
+/// first (the converter has just written it), then dropped (clean pages of a file nobody maps:
+/// the kernel honours it without root).
 void evict(const std::string& path) {
     const int fd = ::open(path.c_str(), O_RDONLY);
     if (fd < 0) return;

@@ -98,7 +98,7 @@ bool TouchValidator::on_fault(const void* address, bool write) noexcept {
         // Zero pages over the block: a zero node has no stored child, so nothing beyond it is
         // followed while the frame that is about to be refused runs out.
         if (::mmap(block, size_t(len), PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED, -1, 0) == MAP_FAILED) return false;
-        state_[b].store(kZeroed, std::memory_order_release);
+        state_[b].store(kReadable, std::memory_order_release);
     }
     // What the check read through the view need not stay resident twice.
     ::madvise(const_cast<std::byte*>(view_) + lo, size_t(len), MADV_DONTNEED);
@@ -128,11 +128,10 @@ template <typename T> bool TouchValidator::check_section(uint64_t i, uint64_t lo
     const uint64_t end = std::min(hi, s.offset + s.bytes);
     const uint64_t to = std::min(s.count, (end - s.offset + rec - 1) / rec);
     const bool caps_below = s.depth == uint64_t(info_.dmax) - 2;
-    const SectionEntry& next = table_[i + 1];   // depth + 1 of the same step: exists below the caps
-    const uint64_t next_count = caps_below ? next.count - kCapReadSlack : next.count;   // >= slack (check_table)
+    const uint64_t below = next_count(i);
     const auto* nodes = reinterpret_cast<const InteriorNode<T>*>(view_ + s.offset);
     for (uint64_t n = from; n < to; ++n)
-        if (node_defect(nodes[n], caps_below, next_count) != NodeDefect::none) {
+        if (node_defect(nodes[n], caps_below, below) != NodeDefect::none) {
             if (!failed_.exchange(true, std::memory_order_acq_rel)) {
                 bad_section_ = i;
                 bad_node_ = n;
@@ -143,18 +142,21 @@ template <typename T> bool TouchValidator::check_section(uint64_t i, uint64_t lo
     return true;
 }
 
+uint64_t TouchValidator::next_count(uint64_t i) const noexcept {
+    const SectionEntry& next = table_[i + 1];   // depth + 1 of the same step: exists below the caps
+    return next.depth == uint64_t(info_.dmax) - 1 ? next.count - kCapReadSlack : next.count;   // >= slack (check_table)
+}
+
 std::optional<std::string> TouchValidator::failure() const {
     if (!recorded_.load(std::memory_order_acquire)) return std::nullopt;
     const SectionEntry& s = table_[bad_section_];
     const bool caps_below = s.depth == uint64_t(info_.dmax) - 2;
-    const SectionEntry& next = table_[bad_section_ + 1];
-    const uint64_t next_count = caps_below ? next.count - kCapReadSlack : next.count;
     const std::string problem = dispatch_scalar_type(info_.type, [&](auto t) {
         using T = decltype(t);
-        return node_problem(reinterpret_cast<const InteriorNode<T>*>(view_ + s.offset)[bad_node_], caps_below, next_count);
+        return node_problem(reinterpret_cast<const InteriorNode<T>*>(view_ + s.offset)[bad_node_], caps_below,
+                            next_count(bad_section_));
     });
-    return "step " + std::to_string(s.step) + ", depth " + std::to_string(s.depth) + " (interior nodes), node " +
-           std::to_string(bad_node_) + ": " + problem;
+    return where(s.step, int(s.depth), info_.dmax) + ", node " + std::to_string(bad_node_) + ": " + problem;
 }
 
 }  // namespace octiso::format

@@ -60,12 +60,15 @@ public:
     uint64_t block_bytes() const { return block_bytes_; }
 
 private:
-    enum State : uint8_t { kReadable = 0, kProtected = 1, kZeroed = 2 };
+    enum State : uint8_t { kReadable = 0, kProtected = 1 };   // a zeroed block is readable too
     bool on_fault(const void* address, bool write) noexcept;
     /// Checks every interior node intersecting [lo, hi) of the file through the view; records
     /// the first defect and returns false if there is one.
     bool check_range(uint64_t lo, uint64_t hi) noexcept;
     template <typename T> bool check_section(uint64_t section, uint64_t lo, uint64_t hi) noexcept;
+    /// What the children of interior section i may index: the next level's nodes, or the bytes
+    /// of caps without their zero slack (the loader's cap_bytes).
+    uint64_t next_count(uint64_t i) const noexcept;
 
     std::string path_;
     const std::byte* base_;

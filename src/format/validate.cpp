@@ -39,10 +39,6 @@ std::string hex(uint64_t v) {
     return buf;
 }
 
-std::string where(uint32_t step, int depth, int dmax) {
-    return "step " + std::to_string(step) + ", depth " + std::to_string(depth) +
-           (depth == dmax - 1 ? " (caps)" : " (interior nodes)");
-}
 
 /// What one chunk of nodes at a depth found on its own; the stitch checks the boundaries.
 struct ChunkResult {
@@ -58,6 +54,11 @@ struct ChunkResult {
 constexpr uint64_t kChunk = 1u << 15;
 
 }  // namespace
+
+std::string where(uint32_t step, int depth, int dmax) {
+    return "step " + std::to_string(step) + ", depth " + std::to_string(depth) +
+           (depth == dmax - 1 ? " (caps)" : " (interior nodes)");
+}
 
 // The node's own fields (formats 3 and 4, octree.h): the cap width where caps lie below, zero high
 // offset bits and zero width elsewhere, ordered finite bounds, lattice samples inside their ranges;

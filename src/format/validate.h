@@ -37,6 +37,8 @@ template <typename T> StepSizes validate_counts(const std::string& subject, cons
 /// what an in-range index or cap offset points at). No allocation: safe in a fault handler.
 enum class NodeDefect : uint8_t { none, cap_bits, high_fields, bounds, lattice_sample, children_past_end };
 template <typename T> NodeDefect node_defect(const InteriorNode<T>& n, bool caps_below, uint64_t next_count) noexcept;
+/// "step S, depth D (interior nodes)" or "(caps)": how every message names a section.
+std::string where(uint32_t step, int depth, int dmax);
 /// The same checks in words, as validate_tree reports them (empty when the node is fine).
 template <typename T> std::string node_problem(const InteriorNode<T>& n, bool caps_below, uint64_t next_count);
 

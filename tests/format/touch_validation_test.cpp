@@ -151,7 +151,7 @@ TEST(TouchValidation, RandomFlipsGiveAReportOrASafeWalk) {
     const OctBytes good(fx.good);
     const uint64_t begin = good.entry(0).offset, end = good.header().section_table_offset;
     std::mt19937_64 rng(91);
-    int reported = 0, clean = 0;
+    int reported = 0;   // flips in min/max that keep every range ordered load clean under both modes
     for (int trial = 0; trial < 60; ++trial) {
         OctBytes b = good;
         for (int k = 0; k < 64; ++k) {
@@ -164,14 +164,14 @@ TEST(TouchValidation, RandomFlipsGiveAReportOrASafeWalk) {
         try {
             walk(f.step<uint8_t>(0));
             f.check_unchanged();
-            ++clean;
         } catch (const Error& e) {
             EXPECT_EQ(e.subject(), fx.bad);
+            // Touched checks a subset of Full's rules: what it refuses, Full refuses too.
+            EXPECT_FALSE(full_problem(fx.bad).empty()) << e.what();
             ++reported;
         }
     }
     EXPECT_GT(reported, 0);
-    EXPECT_EQ(reported + clean, 60);
 }
 
 }  // namespace
