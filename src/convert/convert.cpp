@@ -16,6 +16,7 @@
 #include "convert/stream_build.h"
 #include "io/header_check.h"
 #include "io/nifti_header.h"
+#include "io/text_layout.h"
 #include "io/volume_stream.h"
 #include "octiso/any_octree.h"
 #include "octiso/convert.h"
@@ -222,11 +223,16 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
         !memory.force_in_memory && !source.is_synthetic() && is_streamable(source.step_path(0), source.raw_options());
     if (streamable) {
         // Bad dims are reported by either reader with the same words; let the in-memory one do it.
-        const bool nifti = detect_volume_format(source.step_path(0)) == VolumeFormat::nifti && !source.raw_options().dims;
+        const VolumeFormat format =
+            source.raw_options().dims ? VolumeFormat::raw : detect_volume_format(source.step_path(0));
+        const bool nifti = format == VolumeFormat::nifti;
         std::optional<io::NiftiHeader> header;
         if (nifti) header = io::read_nifti_header(source.step_path(0));
-        const Dims d = nifti ? header->dims : *source.raw_options().dims;
-        const ScalarType t = nifti ? header->type : *source.raw_options().type;
+        std::optional<io::DataLayout> layout;
+        if (format == VolumeFormat::nrrd || format == VolumeFormat::meta_image)
+            layout = io::text_data_layout(source.step_path(0), format).layout;   // streamable: it has one
+        const Dims d = nifti ? header->dims : layout ? layout->dims : *source.raw_options().dims;
+        const ScalarType t = nifti ? header->type : layout ? layout->type : *source.raw_options().type;
         const bool valid = d.x && d.y && d.z && d.max_extent() <= Dims::kMaxExtent &&
                            d.voxels() / d.x / d.y == d.z && d.voxels() <= UINT64_MAX / 8;
         const bool fits = !valid || d.voxels() * scalar_type_bytes(t) <= budget / 2;

@@ -14,72 +14,15 @@
 #include <sys/stat.h>
 #include <zlib.h>
 
+#include "io/text_header.h"
 #include "octiso/error.h"
 
 namespace octiso::io {
 
 namespace {
 
-/// A whitespace-separated list of extents ("sizes: 12 5 4"), each a decimal integer of at most 18
-/// digits (so the product check cannot be fooled by an overflowing parse); `what` names the field.
-std::vector<uint64_t> parse_sizes(const std::string& text, const std::string& what, const std::string& path) {
-    std::vector<uint64_t> sizes;
-    std::istringstream ss(text);
-    std::string tok;
-    while (ss >> tok) {
-        if (tok.find_first_not_of("0123456789") != std::string::npos || tok.size() > 18)
-            throw Error(path, what + " '" + text + "' are not positive integers");
-        sizes.push_back(std::stoull(tok));
-    }
-    if (sizes.empty()) throw Error(path, what + " field is empty");
-    return sizes;
-}
-
 constexpr uint64_t kDeflateMaxRatio = 1032;
-constexpr size_t kHeaderLimit = 1 << 16;
-
 std::string num(uint64_t v) { return std::to_string(v); }
-
-uint64_t file_size(const std::string& path) {
-    struct stat st {};
-    return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) ? uint64_t(st.st_size) : 0;
-}
-
-std::string head_of(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    std::string s(kHeaderLimit, '\0');
-    f.read(s.data(), std::streamsize(s.size()));
-    s.resize(size_t(f.gcount()));
-    return s;
-}
-
-std::string folder_of(const std::string& path) {
-    const size_t slash = path.find_last_of('/');
-    return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
-}
-
-std::string trim(std::string s) {
-    while (!s.empty() && std::isspace((unsigned char)s.back())) s.pop_back();
-    size_t i = 0;
-    while (i < s.size() && std::isspace((unsigned char)s[i])) ++i;
-    return s.substr(i);
-}
-
-std::string lower(std::string s) {
-    for (char& c : s) c = char(std::tolower((unsigned char)c));
-    return s;
-}
-
-/// count * bytes with overflow refused.
-uint64_t product(const std::vector<uint64_t>& sizes, uint64_t element_bytes, const std::string& path) {
-    uint64_t p = element_bytes;
-    for (uint64_t s : sizes) {
-        if (s == 0) throw Error(path, "header declares an axis of size 0");
-        if (p > UINT64_MAX / s) throw Error(path, "header declares more voxels than 64 bits can count");
-        p *= s;
-    }
-    return p;
-}
 
 [[noreturn]] void too_big(const std::string& path, const std::string& what, uint64_t declared, uint64_t held,
                           bool compressed) {
@@ -115,7 +58,7 @@ int nifti_type_bytes(int datatype) {
 }
 
 uint64_t check_nifti(const std::string& path) {
-    const bool gz = lower(path).size() >= 3 && lower(path).substr(path.size() - 3) == ".gz";
+    const bool gz = lower_case(path).size() >= 3 && lower_case(path).substr(path.size() - 3) == ".gz";
     unsigned char h[540] = {};
     size_t n = 0;
     if (gz) {
@@ -130,7 +73,7 @@ uint64_t check_nifti(const std::string& path) {
         f.read(reinterpret_cast<char*>(h), sizeof h);
         n = size_t(f.gcount());
     }
-    const uint64_t bytes = file_size(path);
+    const uint64_t bytes = regular_file_size(path);
     check_nifti_header(h, n, gz ? (bytes > UINT64_MAX / kDeflateMaxRatio ? UINT64_MAX : bytes * kDeflateMaxRatio) : bytes,
                        !gz, path);
     return 0;   // NIfTI is streamed (nifti_stream.cpp); its size is the parsed header's business
@@ -138,55 +81,27 @@ uint64_t check_nifti(const std::string& path) {
 
 // ---- NRRD ----------------------------------------------------------------------------------
 
-int nrrd_type_bytes(const std::string& t) {
-    static const std::map<std::string, int> types = {
-        {"signed char", 1}, {"int8", 1}, {"int8_t", 1}, {"uchar", 1}, {"unsigned char", 1}, {"uint8", 1}, {"uint8_t", 1},
-        {"short", 2}, {"short int", 2}, {"signed short", 2}, {"signed short int", 2}, {"int16", 2}, {"int16_t", 2},
-        {"ushort", 2}, {"unsigned short", 2}, {"unsigned short int", 2}, {"uint16", 2}, {"uint16_t", 2},
-        {"int", 4}, {"signed int", 4}, {"int32", 4}, {"int32_t", 4}, {"uint", 4}, {"unsigned int", 4}, {"uint32", 4},
-        {"uint32_t", 4}, {"longlong", 8}, {"long long", 8}, {"long long int", 8}, {"signed long long", 8},
-        {"signed long long int", 8}, {"int64", 8}, {"int64_t", 8}, {"ulonglong", 8}, {"unsigned long long", 8},
-        {"unsigned long long int", 8}, {"uint64", 8}, {"uint64_t", 8}, {"float", 4}, {"double", 8}};
-    const auto it = types.find(lower(t));
-    return it == types.end() ? 0 : it->second;
-}
-
 uint64_t check_nrrd(const std::string& path) {
-    const std::string head = head_of(path);
-    size_t end = head.find("\n\n");
-    size_t skip = 2;
-    if (const size_t crlf = head.find("\r\n\r\n"); crlf != std::string::npos && crlf < end) end = crlf, skip = 4;
-    std::map<std::string, std::string> field;
-    std::istringstream lines(head.substr(0, end == std::string::npos ? head.size() : end));
-    std::string line;
-    while (std::getline(lines, line)) {
-        if (line.empty() || line[0] == '#') continue;
-        const size_t colon = line.find(':');
-        if (colon == std::string::npos) continue;
-        std::string key = lower(trim(line.substr(0, colon)));
-        std::string value = line.substr(colon + 1);
-        if (!value.empty() && value[0] == '=') continue;   // key:=value pairs
-        key.erase(std::remove(key.begin(), key.end(), ' '), key.end());
-        field[key] = trim(value);
-    }
+    TextHeader header = parse_nrrd_header(path);
+    auto& field = header.field;
     if (!field.count("sizes") || !field.count("type")) return 0;   // VTK will say what is missing
     const int tb = nrrd_type_bytes(field["type"]);
     if (tb == 0) throw Error(path, "NRRD type '" + field["type"] + "' is not supported");
     const std::vector<uint64_t> sizes = parse_sizes(field["sizes"], "NRRD sizes", path);
-    const uint64_t declared = product(sizes, uint64_t(tb), path);
-    const std::string enc = lower(field.count("encoding") ? field["encoding"] : "raw");
+    const uint64_t declared = checked_product(sizes, uint64_t(tb), path);
+    const std::string enc = lower_case(field.count("encoding") ? field["encoding"] : "raw");
     uint64_t available = 0;
     std::string data = field.count("datafile") ? field["datafile"] : "";
     if (data.empty()) {
-        if (end == std::string::npos) {
-            if (head.size() < kHeaderLimit) throw Error(path, "NRRD header has no blank line before the data");
+        if (!header.data_offset) {
+            if (regular_file_size(path) < kTextHeaderLimit) throw Error(path, "NRRD header has no blank line before the data");
             return 0;
         }
-        available = file_size(path) - uint64_t(end + skip);
+        available = regular_file_size(path) - *header.data_offset;
     } else {
-        if (data.find('%') != std::string::npos || data.rfind("LIST", 0) == 0 || data.find(' ') != std::string::npos)
-            return 0;   // a list or pattern of files: left to VTK
-        if (data[0] != '/') data = folder_of(path) + data;
+        const std::optional<std::string> single = single_data_file(path, data);
+        if (!single) return 0;   // a list or pattern of files: left to VTK
+        data = *single;
         struct stat st {};
         if (::stat(data.c_str(), &st) != 0) throw Error(path, "NRRD data file '" + data + "' does not exist");
         available = uint64_t(st.st_size);
@@ -209,12 +124,12 @@ int vtk_type_bytes(const std::string& t) {
     static const std::map<std::string, int> types = {
         {"unsigned_char", 1}, {"char", 1}, {"signed_char", 1}, {"unsigned_short", 2}, {"short", 2}, {"unsigned_int", 4},
         {"int", 4}, {"unsigned_long", 8}, {"long", 8}, {"float", 4}, {"double", 8}, {"vtktypeint64", 8}, {"vtktypeuint64", 8}};
-    const auto it = types.find(lower(t));
+    const auto it = types.find(lower_case(t));
     return it == types.end() ? 0 : it->second;
 }
 
 uint64_t check_legacy_vtk(const std::string& path) {
-    const std::string head = head_of(path);
+    const std::string head = header_bytes(path);
     std::istringstream in(head);
     std::string line;
     bool binary = false;
@@ -222,12 +137,12 @@ uint64_t check_legacy_vtk(const std::string& path) {
     int tb = 0;
     std::vector<uint64_t> dims;
     for (int lineno = 0; std::getline(in, line); ++lineno) {
-        if (lineno == 2) binary = lower(trim(line)) == "binary";
+        if (lineno == 2) binary = lower_case(trimmed(line)) == "binary";
         if (lineno < 3) continue;
         std::istringstream w(line);
         std::string key;
         w >> key;
-        key = lower(key);
+        key = lower_case(key);
         if (key == "dimensions") {
             uint64_t v;
             while (w >> v) dims.push_back(v);
@@ -243,14 +158,14 @@ uint64_t check_legacy_vtk(const std::string& path) {
             if (tb == 0) throw Error(path, "legacy VTK scalar type '" + type + "' is not supported");
         } else if (key == "lookup_table" && tb > 0) {
             if (dims.size() == 3) {
-                const uint64_t n = product(dims, 1, path);
+                const uint64_t n = checked_product(dims, 1, path);
                 if (n != point_data)
                     throw Error(path, "legacy VTK header: DIMENSIONS give " + num(n) + " points but POINT_DATA says " + num(point_data));
             }
             const std::streamoff at = in.tellg();
             if (at < 0) return 0;
-            const uint64_t declared = product({point_data, components}, uint64_t(tb), path);
-            const uint64_t available = file_size(path) - uint64_t(at);
+            const uint64_t declared = checked_product({point_data, components}, uint64_t(tb), path);
+            const uint64_t available = regular_file_size(path) - uint64_t(at);
             if (binary) check_bound(path, "legacy VTK header", declared, available, false);
             else check_bound(path, "legacy VTK header", declared / uint64_t(tb) * 2 - 1, available, false);
             return declared;
@@ -261,44 +176,24 @@ uint64_t check_legacy_vtk(const std::string& path) {
 
 // ---- MetaImage -----------------------------------------------------------------------------
 
-int met_type_bytes(const std::string& t) {
-    static const std::map<std::string, int> types = {
-        {"MET_UCHAR", 1}, {"MET_CHAR", 1}, {"MET_USHORT", 2}, {"MET_SHORT", 2}, {"MET_UINT", 4}, {"MET_INT", 4},
-        {"MET_ULONG", 8}, {"MET_LONG", 8}, {"MET_ULONG_LONG", 8}, {"MET_LONG_LONG", 8}, {"MET_FLOAT", 4}, {"MET_DOUBLE", 8}};
-    const auto it = types.find(t);
-    return it == types.end() ? 0 : it->second;
-}
-
 uint64_t check_meta_image(const std::string& path) {
-    const std::string head = head_of(path);
-    std::istringstream in(head);
-    std::string line;
-    std::map<std::string, std::string> field;
-    std::streamoff data_at = -1;
-    while (std::getline(in, line)) {
-        const size_t eq = line.find('=');
-        if (eq == std::string::npos) continue;
-        const std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
-        field[key] = value;
-        if (key == "ElementDataFile") {
-            data_at = in.tellg();
-            break;
-        }
-    }
-    if (data_at < 0 || !field.count("DimSize") || !field.count("ElementType")) return 0;   // VTK reports it
-    const int tb = met_type_bytes(field["ElementType"]);
+    TextHeader header = parse_meta_image_header(path);
+    auto& field = header.field;
+    if (!header.data_offset || !field.count("DimSize") || !field.count("ElementType")) return 0;   // VTK reports it
+    const int tb = meta_image_type_bytes(field["ElementType"]);
     if (tb == 0) throw Error(path, "MetaImage ElementType '" + field["ElementType"] + "' is not supported");
     std::vector<uint64_t> sizes = parse_sizes(field["DimSize"], "MetaImage DimSize", path);
     if (field.count("ElementNumberOfChannels")) sizes.push_back(std::strtoull(field["ElementNumberOfChannels"].c_str(), nullptr, 10));
-    const uint64_t declared = product(sizes, uint64_t(tb), path);
-    const bool compressed = lower(field["CompressedData"]) == "true";
+    const uint64_t declared = checked_product(sizes, uint64_t(tb), path);
+    const bool compressed = lower_case(field["CompressedData"]) == "true";
     std::string data = field["ElementDataFile"];
     uint64_t available = 0;
     if (data == "LOCAL" || data == "Local" || data == "local") {
-        available = file_size(path) - uint64_t(data_at);
+        available = regular_file_size(path) - *header.data_offset;
     } else {
-        if (data.find('%') != std::string::npos || data.rfind("LIST", 0) == 0 || data.find(' ') != std::string::npos) return 0;
-        if (data[0] != '/') data = folder_of(path) + data;
+        const std::optional<std::string> single = single_data_file(path, data);
+        if (!single) return 0;
+        data = *single;
         struct stat st {};
         if (::stat(data.c_str(), &st) != 0) throw Error(path, "MetaImage data file '" + data + "' does not exist");
         available = uint64_t(st.st_size);
@@ -350,7 +245,7 @@ void check_nifti_header(const unsigned char* h, size_t n, uint64_t bound, bool e
         throw Error(path, "NIfTI vox_offset " + std::to_string(vox) + " is not a whole byte offset past the header");
     const uint64_t offset = uint64_t(vox);
     // 5. The declared voxels fit in what follows vox_offset.
-    const uint64_t declared = product(sizes, uint64_t(tb), path);
+    const uint64_t declared = checked_product(sizes, uint64_t(tb), path);
     const uint64_t available = offset > bound ? 0 : bound - offset;
     if (declared > available) too_big(path, "NIfTI header", declared, available, !exact);
 }

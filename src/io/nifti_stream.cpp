@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <climits>
 #include <cstring>
-#include <new>
 #include <vector>
 
 #include <zlib.h>
@@ -97,18 +96,7 @@ LoadedVolume read_nifti(const std::string& path) {
     if (s->time_steps() > 1)
         throw Error(path, "is a 4-D NIfTI of " + std::to_string(s->time_steps()) +
                               " volumes: octiso-convert makes it a time series, one step per volume");
-    auto buffer = std::make_shared<std::vector<std::byte>>();
-    try {
-        buffer->resize(size_t(s->bytes()));
-    } catch (const std::bad_alloc&) {
-        throw Error(path, "out of memory reading the " + std::to_string(s->bytes()) + " voxel bytes the header declares");
-    }
-    s->read_layers(s->dims().z, buffer->data());
-    const std::byte* data = buffer->data();
-    LoadedVolume v(std::move(buffer), data, s->type(), s->dims(), s->placement(), false, path, VolumeFormat::nifti);
-    v.set_source_order(s->value_scale(), s->flipped_axes());
-    v.set_warning(s->warning());
-    return v;
+    return read_stream_whole(*s);
 }
 
 }  // namespace octiso

@@ -27,15 +27,7 @@ public:
 
 protected:
     void read_bytes(uint64_t bytes, std::byte* dst) override {
-        uint64_t done = 0;
-        while (done < bytes) {
-            const size_t chunk = size_t(std::min<uint64_t>(bytes - done, uint64_t(1) << 30));
-            const ssize_t n = ::pread(fd_, dst + done, chunk, off_t(pos_ + done));
-            if (n < 0 && errno == EINTR) continue;
-            if (n < 0) throw Error(source(), std::string("read failed: ") + std::strerror(errno));
-            if (n == 0) throw Error(source(), "file ended early (it changed while being read)");
-            done += uint64_t(n);
-        }
+        pread_fully(fd_, dst, bytes, pos_, source());
         pos_ += bytes;
         read_ += bytes;
         if (swap_) swap_scalars_in_place(dst, bytes, scalar_type_bytes(type()));
@@ -49,6 +41,18 @@ private:
 };
 
 }  // namespace
+
+void pread_fully(int fd, std::byte* dst, uint64_t bytes, uint64_t pos, const std::string& source) {
+    uint64_t done = 0;
+    while (done < bytes) {
+        const size_t chunk = size_t(std::min<uint64_t>(bytes - done, uint64_t(1) << 30));
+        const ssize_t n = ::pread(fd, dst + done, chunk, off_t(pos + done));
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) throw Error(source, std::string("read failed: ") + std::strerror(errno));
+        if (n == 0) throw Error(source, "file ended early (it changed while being read)");
+        done += uint64_t(n);
+    }
+}
 
 std::unique_ptr<VolumeStream> open_raw_stream(const std::string& path, Dims dims, ScalarType type, Endian endian,
                                               uint64_t offset) {

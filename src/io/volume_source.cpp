@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <new>
+#include <vector>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -138,15 +140,36 @@ Placement overridden_placement(Placement placement, Dims dims, const std::string
 
 }  // namespace
 
+LoadedVolume read_stream_whole(VolumeStream& s) {
+    auto buffer = std::make_shared<std::vector<std::byte>>();
+    try {
+        buffer->resize(size_t(s.bytes()));
+    } catch (const std::bad_alloc&) {
+        throw Error(s.source(), "out of memory reading the " + std::to_string(s.bytes()) + " voxel bytes the header declares");
+    }
+    s.read_layers(s.dims().z - s.next_layer(), buffer->data() + s.next_layer() * s.layer_bytes());
+    const std::byte* data = buffer->data();
+    LoadedVolume v(std::move(buffer), data, s.type(), s.dims(), s.placement(), false, s.source(), s.format());
+    v.set_source_order(s.value_scale(), s.flipped_axes());
+    v.set_warning(s.warning());
+    return v;
+}
+
 LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
     const VolumeFormat format = choose_format(path, options);
     // NIfTI goes through the same reader as the out-of-core path (nifti_stream.cpp), not VTK's:
     // VTK applies neither scl_slope nor the sform's flips, and reverses the slices of qfac -1
     // files, so one reader for both paths is what keeps their .oct bytes equal (CONVENTIONS 2b).
+    // NRRD and MetaImage likewise wherever the stream reads them (text_stream.cpp): VTK 9.1's
+    // NRRD reader leaves big-endian gzip data unswapped (text_stream_test.cpp shows it), and
+    // VTK still gives the placement. The layouts the stream leaves alone are VTK's.
+    const bool text = (format == VolumeFormat::nrrd || format == VolumeFormat::meta_image) && !options.array &&
+                      !text_stream_refusal(path, format);
     LoadedVolume volume = format == VolumeFormat::raw
                               ? read_raw(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
                                          options.offset.value_or(0))
                           : format == VolumeFormat::nifti ? read_nifti(path)
+                          : text                          ? read_stream_whole(*open_text_stream(path, format))
                                                           : read_vtk(path, format, options.array);
     volume.set_placement(overridden_placement(volume.placement(), volume.dims(), path, options));
     return volume;
@@ -154,6 +177,7 @@ LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
 
 bool is_streamable(const std::string& path, const RawOptions& options) {
     const VolumeFormat f = choose_format(path, options);
+    if (f == VolumeFormat::nrrd || f == VolumeFormat::meta_image) return !options.array && !text_stream_refusal(path, f);
     return f == VolumeFormat::raw || f == VolumeFormat::nifti;
 }
 
@@ -165,6 +189,8 @@ std::unique_ptr<VolumeStream> open_volume_stream(const std::string& path, const 
                             options.offset.value_or(0));
     else if (format == VolumeFormat::nifti)
         s = open_nifti_stream(path);
+    else if (format == VolumeFormat::nrrd || format == VolumeFormat::meta_image)
+        s = open_text_stream(path, format);
     else
         throw Error(path, std::string(volume_format_name(format)) + " input is read whole, not streamed", ErrorKind::Other);
     s->set_placement(overridden_placement(s->placement(), s->dims(), path, options));

@@ -1,7 +1,8 @@
 // VolumeStream: a volume read front to back, a few layers (z slices) at a time, for the
 // out-of-core converter (issue 13). Unlike LoadedVolume nothing is mapped or kept: each call
 // reads the next layers with ordinary reads into the caller's buffer, in native byte order.
-// The readers behind it: raw_stream.cpp, nifti_stream.cpp; open_volume_stream() picks one.
+// The readers behind it: raw_stream.cpp, nifti_stream.cpp, text_stream.cpp; open_volume_stream()
+// picks one.
 #pragma once
 
 #include <cstddef>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "octiso/loaded_volume.h"
@@ -97,13 +99,32 @@ std::unique_ptr<VolumeStream> open_raw_stream(const std::string& path, Dims dims
 /// oblique affine is placed as VTK does and named in warning().
 std::unique_ptr<VolumeStream> open_nifti_stream(const std::string& path);
 
+/// NRRD (.nrrd, .nhdr) or MetaImage (.mha, .mhd) with raw or gzip/zlib data in one file
+/// (text_stream.cpp): the header's layout (text_layout.h) read with pread or inflated as read,
+/// swapped when big-endian, placed as VTK places it. Throws Error(path, ...) when
+/// text_stream_refusal() gives a reason.
+std::unique_ptr<VolumeStream> open_text_stream(const std::string& path, VolumeFormat format);
+/// Why a NRRD or MetaImage file cannot be streamed (its layout is one the stream does not read,
+/// or VTK reads its grid or type differently from the header's plain meaning); nullopt if it can.
+std::optional<std::string> text_stream_refusal(const std::string& path, VolumeFormat format);
+
+/// Reads exactly `bytes` at `pos` of `fd`, retrying short reads; Error(source, ...) if the file
+/// ends first (it changed since its size was checked) or a read fails.
+void pread_fully(int fd, std::byte* dst, uint64_t bytes, uint64_t pos, const std::string& source);
+
 /// The whole of a 3-D NIfTI file through open_nifti_stream() into memory: the in-memory
 /// converter's reader, so both paths read NIfTI with the same code. Throws Error(path, ...) for
 /// a 4-D file (convert() makes those a series through the stream).
 LoadedVolume read_nifti(const std::string& path);
 
-/// Whether open_volume_stream() can stream `path` (raw and NIfTI input); other formats are read
-/// whole by open_volume().
+/// Every layer of the stream's current volume read into memory, as a LoadedVolume with the
+/// stream's placement, value scale, flips and warning: the in-memory converter's reader for the
+/// formats it streams, so that both paths read them with the same code. Error(source, ...) when
+/// the voxels do not fit in memory.
+LoadedVolume read_stream_whole(VolumeStream& stream);
+
+/// Whether open_volume_stream() can stream `path` (raw, NIfTI, and NRRD or MetaImage that
+/// text_stream_refusal() accepts); other input is read whole by open_volume().
 bool is_streamable(const std::string& path, const RawOptions& options);
 
 /// The streaming counterpart of open_volume(): the same format choice, flag checks, placement

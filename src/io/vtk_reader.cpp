@@ -17,6 +17,7 @@
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkImageData.h>
+#include <vtkInformation.h>
 #include <vtkLogger.h>
 #include <vtkMetaImageReader.h>
 #include <vtkNIFTIImageReader.h>
@@ -25,12 +26,14 @@
 #include <vtkOutputWindow.h>
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 #include <vtkStructuredPointsReader.h>
 #include <vtkType.h>
 #include <vtkXMLImageDataReader.h>
 
 #include "io/header_check.h"
 #include "io/input_file.h"
+#include "io/vtk_information.h"
 #include "octiso/reader.h"
 
 namespace {
@@ -158,6 +161,46 @@ vtkSmartPointer<vtkAlgorithm> make_reader(octiso::VolumeFormat format, const std
     throw octiso::Error(path, "not a VTK-readable format", octiso::ErrorKind::Other);
 }
 
+// Runs the reader (the whole read, or the header only) with both of VTK's error channels captured;
+// the first message becomes Error(path, what + message).
+void run_captured(vtkAlgorithm* reader, octiso::VolumeFormat format, const std::string& path, const std::string& what,
+                  bool information_only) {
+    using octiso::Error;
+    ErrorCatcher catcher;
+    auto callback = vtkSmartPointer<vtkCallbackCommand>::New();
+    callback->SetCallback(&ErrorCatcher::on_error);
+    callback->SetClientData(&catcher);
+    reader->AddObserver(vtkCommand::ErrorEvent, callback);
+    t_vtk_window_text.clear();
+    {
+        std::optional<StdStreamsMuted> muted;
+        if (format == octiso::VolumeFormat::meta_image) muted.emplace();
+        try {
+            if (information_only) reader->UpdateInformation();
+            else reader->Update();
+        } catch (const std::bad_alloc&) {
+            throw Error(path, what + "out of memory reading the voxels the header declares");
+        } catch (const std::length_error&) {
+            throw Error(path, what + "the header declares more voxels than can be allocated");
+        }
+    }
+    const std::string window_text = std::move(t_vtk_window_text);
+    t_vtk_window_text.clear();
+    if (!catcher.text.empty()) throw Error(path, what + clean_vtk_message(catcher.text));
+    if (!window_text.empty()) throw Error(path, what + clean_vtk_message(window_text));
+    if (reader->GetErrorCode() != 0) throw Error(path, what + "VTK error code " + std::to_string(reader->GetErrorCode()));
+}
+
+/// Voxel (0,0,0) of our grid is the extent's lower corner, not VTK's index 0.
+octiso::Placement placement_of(const double* spacing, const double* origin, const int* extent) {
+    octiso::Placement placement;
+    for (int a = 0; a < 3; ++a) {
+        placement.spacing[size_t(a)] = spacing[a];
+        placement.origin[size_t(a)] = origin[a] + extent[2 * a] * spacing[a];
+    }
+    return placement;
+}
+
 }  // namespace
 
 namespace octiso {
@@ -178,28 +221,7 @@ LoadedVolume read_vtk(const std::string& path, VolumeFormat format, const std::o
     }
 
     // 1. Run the reader with both error channels captured.
-    ErrorCatcher catcher;
-    auto callback = vtkSmartPointer<vtkCallbackCommand>::New();
-    callback->SetCallback(&ErrorCatcher::on_error);
-    callback->SetClientData(&catcher);
-    reader->AddObserver(vtkCommand::ErrorEvent, callback);
-    t_vtk_window_text.clear();
-    {
-        std::optional<StdStreamsMuted> muted;
-        if (format == VolumeFormat::meta_image) muted.emplace();
-        try {
-            reader->Update();
-        } catch (const std::bad_alloc&) {
-            throw Error(path, what + "out of memory reading the voxels the header declares");
-        } catch (const std::length_error&) {
-            throw Error(path, what + "the header declares more voxels than can be allocated");
-        }
-    }
-    const std::string window_text = std::move(t_vtk_window_text);
-    t_vtk_window_text.clear();
-    if (!catcher.text.empty()) throw Error(path, what + clean_vtk_message(catcher.text));
-    if (!window_text.empty()) throw Error(path, what + clean_vtk_message(window_text));
-    if (reader->GetErrorCode() != 0) throw Error(path, what + "VTK error code " + std::to_string(reader->GetErrorCode()));
+    run_captured(reader, format, path, what, /*information_only=*/false);
 
     // 2. The output must be one complete single-component image.
     vtkImageData* image = vtkImageData::SafeDownCast(reader->GetOutputDataObject(0));
@@ -248,15 +270,8 @@ LoadedVolume read_vtk(const std::string& path, VolumeFormat format, const std::o
     if (!scalars->HasStandardMemoryLayout())
         throw Error(path, what + "array is not stored contiguously", ErrorKind::Other);
 
-    // 3. Placement: voxel (0,0,0) of our grid is the extent's lower corner, not VTK's index 0.
-    Placement placement;
-    const double* spacing = image->GetSpacing();
-    const double* origin = image->GetOrigin();
-    const int* extent = image->GetExtent();
-    for (int a = 0; a < 3; ++a) {
-        placement.spacing[size_t(a)] = spacing[a];
-        placement.origin[size_t(a)] = origin[a] + extent[2 * a] * spacing[a];
-    }
+    // 3. Placement.
+    const Placement placement = placement_of(image->GetSpacing(), image->GetOrigin(), image->GetExtent());
 
     // 4. Keep only the array alive; the reader and image go when this function returns.
     scalars->Register(nullptr);
@@ -268,3 +283,33 @@ LoadedVolume read_vtk(const std::string& path, VolumeFormat format, const std::o
 }
 
 }  // namespace octiso
+
+namespace octiso::io {
+
+VtkImageInformation read_vtk_information(const std::string& path, VolumeFormat format) {
+    io::check_input_file(path);
+    io::check_declared_size(path, format);
+    silence_vtk();
+    const std::string what = "cannot read as " + std::string(volume_format_name(format)) + ": ";
+    vtkSmartPointer<vtkAlgorithm> reader = make_reader(format, path);
+    run_captured(reader, format, path, what, /*information_only=*/true);
+    vtkInformation* info = reader->GetOutputInformation(0);
+    if (!info || !info->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+        throw Error(path, what + "no image extent in the header");
+    int extent[6];
+    info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent);
+    double spacing[3] = {1, 1, 1}, origin[3] = {0, 0, 0};
+    if (info->Has(vtkDataObject::SPACING())) info->Get(vtkDataObject::SPACING(), spacing);
+    if (info->Has(vtkDataObject::ORIGIN())) info->Get(vtkDataObject::ORIGIN(), origin);
+    VtkImageInformation r;
+    for (int a = 0; a < 3; ++a) {
+        const int64_t n = int64_t(extent[2 * a + 1]) - extent[2 * a] + 1;
+        r.extent[size_t(a)] = n < 0 ? 0 : uint64_t(n);
+    }
+    r.type = scalar_type_from_vtk(vtkImageData::GetScalarType(info));
+    r.components = vtkImageData::GetNumberOfScalarComponents(info);
+    r.placement = placement_of(spacing, origin, extent);
+    return r;
+}
+
+}  // namespace octiso::io
