@@ -17,6 +17,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <tbb/parallel_for.h>
+
 #include "bench/bench.h"
 #include "bench/tools.h"
 #include "octiso/error.h"
@@ -26,26 +28,57 @@ namespace octiso::bench {
 namespace {
 
 const char* const kOutOfCoreUsage =
-    "usage: octiso-bench outofcore [--dims NX,NY,NZ] [--memory BYTES] [--dir DIR] [--threads N] [--keep] [--quick]\n"
+    "usage: octiso-bench outofcore [--dims NX,NY,NZ] [--memory BYTES] [--dir DIR] [--threads N] [--keep]\n"
+    "                              [--streamed-only] [--quick]\n"
     "  u8 NX*NY*NZ (default 1024,1024,1024) written once to DIR (default $TMPDIR) as outofcore_NXxNYxNZ.raw and\n"
-    "  reused; converted with --memory (default 1G) and --in-memory; --keep keeps the input for the next run";
+    "  reused; converted with --memory (default 1G) and --in-memory; --keep keeps the input for the next run.\n"
+    "  --streamed-only: no in-memory run (an input larger than RAM), and the input is removed once hashed and\n"
+    "  converted (unless --keep), so that the extracted copy fits on the disk beside the .oct";
 
 /// The value of voxel (x, y, z): nested shells and slow waves, so the octree has structure at
-/// every depth (about as compressible as the paper's scans).
-uint8_t field(uint32_t x, uint32_t y, uint32_t z) {
-    const double a = std::sin(x * 0.031) * std::cos(y * 0.023) + std::sin(z * 0.017 + x * 0.004);
-    const double r = std::sqrt(double(x % 256) * (x % 256) + double(y % 192) * (y % 192) + double(z % 320) * (z % 320));
-    const double v = 96 + 60 * a + 40 * std::sin(r * 0.05);
-    return uint8_t(std::lround(std::clamp(v, 0.0, 255.0)) & ~3);   // quantised: uniform runs merge
-}
+/// every depth (about as compressible as the paper's scans). The formula, once per voxel:
+///   a = sin(0.031 x) cos(0.023 y) + sin(0.017 z + 0.004 x)
+///   r = |(x mod 256, y mod 192, z mod 320)|,  v = 96 + 60 a + 40 sin(0.05 r)
+/// quantised to multiples of 4 (uniform runs merge). FieldLayer computes exactly these doubles
+/// from tables (the terms in x and y once per layer and row, sin(0.05 r) by the exact integer
+/// r^2), so the 27 GiB input of the larger-than-RAM run is written at disk speed, not at
+/// 5 transcendental calls per voxel (7.5 GiB took 10 minutes that way on one core).
+class FieldLayer {
+public:
+    explicit FieldLayer(Dims d) : d_(d), sx_(d.x), cy_(d.y), wave_(256 * 256 + 192 * 192 + 320 * 320) {
+        for (uint32_t x = 0; x < d.x; ++x) sx_[x] = std::sin(x * 0.031);
+        for (uint32_t y = 0; y < d.y; ++y) cy_[y] = std::cos(y * 0.023);
+        for (size_t r2 = 0; r2 < wave_.size(); ++r2) wave_[r2] = std::sin(std::sqrt(double(r2)) * 0.05);
+    }
+    /// Layer z into `out` (d.x * d.y values), rows in parallel.
+    void fill(uint32_t z, uint8_t* out) const {
+        std::vector<double> sz(d_.x);
+        for (uint32_t x = 0; x < d_.x; ++x) sz[x] = std::sin(z * 0.017 + x * 0.004);
+        const double zz = double(z % 320) * (z % 320);
+        tbb::parallel_for(uint32_t(0), d_.y, [&](uint32_t y) {
+            const double yy = double(y % 192) * (y % 192);
+            uint8_t* row = out + uint64_t(y) * d_.x;
+            for (uint32_t x = 0; x < d_.x; ++x) {
+                const double a = sx_[x] * cy_[y] + sz[x];
+                const double r2 = double(x % 256) * (x % 256) + yy + zz;   // an exact integer
+                const double v = 96 + 60 * a + 40 * wave_[size_t(r2)];
+                row[x] = uint8_t(std::lround(std::clamp(v, 0.0, 255.0)) & ~3);
+            }
+        });
+    }
+
+private:
+    Dims d_;
+    std::vector<double> sx_, cy_, wave_;
+};
 
 void write_input(const std::string& path, Dims d) {
     std::FILE* f = std::fopen(path.c_str(), "wb");
     if (!f) throw Error(path, "cannot create", ErrorKind::Other);
+    const FieldLayer field(d);
     std::vector<uint8_t> layer(uint64_t(d.x) * d.y);
     for (uint32_t z = 0; z < d.z; ++z) {
-        for (uint32_t y = 0; y < d.y; ++y)
-            for (uint32_t x = 0; x < d.x; ++x) layer[uint64_t(y) * d.x + x] = field(x, y, z);
+        field.fill(z, layer.data());
         if (std::fwrite(layer.data(), 1, layer.size(), f) != layer.size()) {
             std::fclose(f);
             throw Error(path, "write failed", ErrorKind::Other);
@@ -87,6 +120,8 @@ struct PathRow {
 
 double mib(uint64_t b) { return double(b) / 1048576.0; }
 
+uint64_t physical_memory_bytes() { return uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE)); }
+
 /// One frame of the converted file from a cold page cache: what opening and validating cost
 /// before the first pixel, and what the frame left resident (issue 13, --verify).
 struct RenderRow {
@@ -112,7 +147,7 @@ int run_outofcore(cli::Args& args) {
         std::cout << kOutOfCoreUsage << "\n";
         return 0;
     }
-    const bool quick = args.flag("--quick"), keep = args.flag("--keep");
+    const bool quick = args.flag("--quick"), keep = args.flag("--keep"), streamed_only = args.flag("--streamed-only");
     const auto dims_flag = args.value("--dims"), memory_flag = args.value("--memory");
     const auto dir_flag = args.value("--dir"), threads_flag = args.value("--threads");
     const std::string results = results_dir(args);
@@ -139,6 +174,7 @@ int run_outofcore(cli::Args& args) {
     std::vector<PathRow> rows;
     const std::string dims_arg = std::to_string(d.x) + "," + std::to_string(d.y) + "," + std::to_string(d.z);
     for (const bool streamed : {true, false}) {
+        if (!streamed && streamed_only) break;
         PathRow r;
         r.name = streamed ? "--memory " + memory : "--in-memory";
         const std::string out = dir + "/outofcore_" + tag + (streamed ? "_streamed.oct" : "_in_memory.oct");
@@ -157,6 +193,7 @@ int run_outofcore(cli::Args& args) {
         r.bytes_read = streamed ? uint64_t(json_number(json, "bytes_read")) : voxels;   // in memory: mapped
         r.spilled = uint64_t(json_number(json, "spilled_bytes"));
         r.piece_side = uint64_t(json_number(json, "piece_side"));
+        if (streamed_only && !keep) std::filesystem::remove(input, ec);   // hashed already: room for the copy
         const std::string extracted = dir + "/outofcore_" + tag + "_extracted.raw";
         run_tool("octiso-info", {out, "--extract-raw", extracted});
         r.lossless = sha256_of(extracted) == input_sha;
@@ -164,7 +201,7 @@ int run_outofcore(cli::Args& args) {
         rows.push_back(r);
     }
     const std::string a = dir + "/outofcore_" + tag + "_streamed.oct", b = dir + "/outofcore_" + tag + "_in_memory.oct";
-    const bool identical = same_files(a, b);
+    const bool identical = !streamed_only && same_files(a, b);
 
     // 3. A 512^2 frame of the file, afar (the whole data) and close up (zoom 8: a corner of it),
     //    under --verify full and touched, each from a cold cache, interleaved.
@@ -193,7 +230,8 @@ int run_outofcore(cli::Args& args) {
     std::filesystem::remove(b, ec);
     if (!keep) std::filesystem::remove(input, ec);
 
-    std::cout << "out-of-core conversion, u8 " << tag << " (" << fmt(mib(voxels), 1) << " MiB), input "
+    std::cout << "out-of-core conversion, u8 " << tag << " (" << fmt(mib(voxels), 1) << " MiB; this machine's RAM "
+              << fmt(mib(physical_memory_bytes()), 0) << " MiB), input "
               << (written ? "written in " + fmt(write_seconds, 1) + " s" : "reused") << " (" << machine_description() << ")\n";
     Table table({"path", "wall s", "build s", "Mvoxel/s", "peak RSS MiB", "read MiB", "written MiB", "spilled MiB",
                  "piece", "extracted sha256 = input"});
@@ -203,8 +241,9 @@ int run_outofcore(cli::Args& args) {
                    fmt(mib(r.file_bytes), 1), fmt(mib(r.spilled), 1), r.streamed ? std::to_string(r.piece_side) + "^3" : "-",
                    r.lossless ? "yes" : "NO"});
     table.print(std::cout);
-    std::cout << "the two .oct files are " << (identical ? "identical, byte for byte" : "DIFFERENT") << "; throughput "
-              << fmt(100.0 * rows[0].mvoxels_per_second / rows[1].mvoxels_per_second, 1) << " % of in-memory\n";
+    if (!streamed_only)
+        std::cout << "the two .oct files are " << (identical ? "identical, byte for byte" : "DIFFERENT") << "; throughput "
+                  << fmt(100.0 * rows[0].mvoxels_per_second / rows[1].mvoxels_per_second, 1) << " % of in-memory\n";
     std::cout << "one frame of the " << fmt(mib(rows[0].file_bytes), 1) << " MiB file, cold page cache:\n";
     Table frames({"view", "--verify", "open to first frame s", "frame s", "file resident MiB", "% of file", "blocks checked", "hits"});
     for (const RenderRow& r : renders)
@@ -215,7 +254,9 @@ int run_outofcore(cli::Args& args) {
     const std::string path = write_json(results, quick ? "outofcore" : "outofcore_" + tag, [&](cli::JsonWriter& j) {
         j.begin_object();
         j.field("dims", tag).field("type", std::string("u8")).field("input_bytes", voxels).field("memory", memory);
-        j.field("machine", machine_description()).field("identical", identical).field("input_sha256", input_sha);
+        j.field("machine", machine_description()).field("input_sha256", input_sha);
+        j.field("physical_memory_bytes", physical_memory_bytes()).field("input_written_seconds", written ? write_seconds : 0.0);
+        if (!streamed_only) j.field("identical", identical);
         j.key("paths").begin_array();
         for (const PathRow& r : rows) {
             j.begin_object().field("path", r.name).field("streamed", r.streamed).field("wall_seconds", r.wall_seconds);
@@ -234,7 +275,8 @@ int run_outofcore(cli::Args& args) {
         j.end_object();
     });
     std::cout << "wrote " << path << "\n";
-    return identical && rows[0].lossless && rows[1].lossless ? 0 : 1;
+    const bool all_lossless = std::all_of(rows.begin(), rows.end(), [](const PathRow& r) { return r.lossless; });
+    return (identical || streamed_only) && all_lossless ? 0 : 1;
 }
 
 const bool kRegistered =

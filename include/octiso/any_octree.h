@@ -110,6 +110,9 @@ public:
     /// `order`. Throws Error unless out.size() == dense_bytes(); `out` needs no alignment.
     void decode(std::span<std::byte> out, std::endian order = std::endian::native) const;
     uint64_t dense_bytes() const;
+    /// Layers z0 .. z1-1 of it (z0 <= z1 <= dims().z): x*y*(z1-z0) values, layer z0 first
+    /// (decode.h decode_layers), so a step larger than memory can be written out slab by slab.
+    void decode_layers(uint32_t z0, uint32_t z1, std::span<std::byte> out, std::endian order = std::endian::native) const;
     /// The voxels of the plane x = `x` (< dims().x) as doubles (exact for every scalar type),
     /// element y + ny * z: the ghost face a sort-last neighbour needs (RenderOptions::ghost_plane).
     std::vector<double> x_plane(uint32_t x) const;

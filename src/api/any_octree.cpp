@@ -26,7 +26,7 @@ struct AnyOctree::Impl {
     virtual std::optional<std::array<double, 2>> value_range() const = 0;
     virtual void append_to(OctWriter& writer) const = 0;
     virtual Renderer make_renderer(const RenderOptions& options, const RenderLimits& limits) const = 0;
-    virtual void decode(std::byte* out, bool swap_bytes) const = 0;
+    virtual void decode(uint32_t z0, uint32_t z1, std::byte* out, bool swap_bytes) const = 0;   // layers [z0, z1)
     virtual PixelTrace trace_pixel(const Camera& camera, const RenderOptions& options, int x, int y) const = 0;
     virtual const void* typed_view() const = 0;   // the Octree<T> for as<T>()
     virtual std::vector<double> x_plane(uint32_t x) const = 0;
@@ -77,13 +77,13 @@ public:
         return Renderer(tree_, placement, options, limits);
     }
 
-    void decode(std::byte* out, bool swap_bytes) const override {
-        const uint64_t n = tree_.dims().voxels();
+    void decode(uint32_t z0, uint32_t z1, std::byte* out, bool swap_bytes) const override {
+        const uint64_t n = uint64_t(tree_.dims().x) * tree_.dims().y * (z1 - z0);
         // In place when `out` can hold T directly; else through an aligned buffer.
         const bool aligned = reinterpret_cast<uintptr_t>(out) % alignof(T) == 0;
         std::vector<T> buffer(aligned ? 0 : size_t(n));
         T* values = aligned ? reinterpret_cast<T*>(out) : buffer.data();
-        decode_to_dense(tree_, values);
+        decode_layers(tree_, z0, z1, values);
         if (swap_bytes)
             for (uint64_t i = 0; i < n; ++i) values[i] = VolumeView<T>::byte_swapped(values[i]);
         if (!aligned) std::memcpy(out, buffer.data(), size_t(n) * sizeof(T));
@@ -245,7 +245,18 @@ void AnyOctree::decode(std::span<std::byte> out, std::endian order) const {
     if (out.size() != bytes)
         throw Error(impl_->source, "decode needs a buffer of " + std::to_string(bytes) + " bytes, found " +
                                        std::to_string(out.size()), ErrorKind::Other);
-    impl_->decode(out.data(), order != std::endian::native);
+    impl_->decode(0, dims().z, out.data(), order != std::endian::native);
+}
+
+void AnyOctree::decode_layers(uint32_t z0, uint32_t z1, std::span<std::byte> out, std::endian order) const {
+    if (z0 > z1 || z1 > dims().z)
+        throw Error(impl_->source, "decode_layers: layers " + std::to_string(z0) + ".." + std::to_string(z1) +
+                                       " outside 0.." + std::to_string(dims().z), ErrorKind::Other);
+    const uint64_t bytes = uint64_t(dims().x) * dims().y * (z1 - z0) * scalar_type_bytes(type());
+    if (out.size() != bytes)
+        throw Error(impl_->source, "decode_layers needs a buffer of " + std::to_string(bytes) + " bytes, found " +
+                                       std::to_string(out.size()), ErrorKind::Other);
+    impl_->decode(z0, z1, out.data(), order != std::endian::native);
 }
 
 template <typename T> const Octree<T>* AnyOctree::as() const {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <unistd.h>
+#include <cstdlib>
 #include <cstring>
 #include <iomanip>
 #include <iostream>
@@ -64,30 +65,60 @@ struct Extract {
 };
 
 /// Decodes step `ex.step` and writes it x-fastest through AtomicOutput, byte-swapped if asked.
+/// Raw output goes out in slabs of layers (kExtractSlabBytes), so a step larger than memory
+/// extracts too (issue 13: a volume larger than RAM comes back byte for byte); formats with a
+/// header are written by VTK from one dense array and keep the memory check.
+constexpr uint64_t kExtractSlabBytes = uint64_t(256) << 20;
+
+/// kExtractSlabBytes, or OCTISO_EXTRACT_SLAB_BYTES where set (tests: slabs of a few layers, so
+/// that a small file crosses slab seams).
+uint64_t extract_slab_bytes() {
+    const char* env = std::getenv("OCTISO_EXTRACT_SLAB_BYTES");
+    if (!env || !*env) return kExtractSlabBytes;
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(env, &end, 10);
+    return end && *end == '\0' && v > 0 ? uint64_t(v) : kExtractSlabBytes;
+}
+
 void extract_raw(const std::shared_ptr<const OctFile>& file, Extract& ex) {
     const OctInfo& info = file->info();
     ex.bytes = checked_volume_bytes(info.dims, info.type, file->path());
-    // The dense array is decoded in memory: refuse up front, naming the size, rather than fail
-    // on allocation (a sparse 16384^3 octree is 98 KB on disk and 16 TiB as an array).
-    const uint64_t memory = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
-    if (ex.bytes > memory)
-        throw Error("--extract-raw", "step " + std::to_string(ex.step) + " of " + file->path() + " is " +
-                                         std::to_string(ex.bytes) + " bytes as a dense array, more than this machine's " +
-                                         std::to_string(memory) + " bytes of memory");
     const AnyOctree step = AnyOctree::step(file, ex.step);
-    std::vector<std::byte> data(size_t(ex.bytes));
     if (ex.with_header) {   // the formats' own byte order declaration: native
+        // The dense array is decoded in memory: refuse up front, naming the size, rather than
+        // fail on allocation (a sparse 16384^3 octree is 98 KB on disk and 16 TiB as an array).
+        const uint64_t memory = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
+        if (ex.bytes > memory)
+            throw Error("--extract", "step " + std::to_string(ex.step) + " of " + file->path() + " is " +
+                                         std::to_string(ex.bytes) + " bytes as a dense array, more than this machine's " +
+                                         std::to_string(memory) + " bytes of memory (--extract-raw writes it slab by slab)");
+        std::vector<std::byte> data(size_t(ex.bytes));
         step.decode(data, std::endian::native);
         file->check_unchanged();
         write_volume_file(ex.path, info.type, info.dims, info.placement, data, info.value_scale, info.flipped_axes);
         return;
     }
-    step.decode(data, ex.big_endian ? std::endian::big : std::endian::little);
-    file->check_unchanged();   // issue 18: the decoded data came from what was validated
     // Raw is the source's bytes back: axes reversed at conversion turned round again (.raw
     // through --extract does the same); reversing moves whole values, so the byte order stays.
-    if (info.flipped_axes) reverse_axes_in_place(data.data(), info.dims, info.dims.z, scalar_type_bytes(info.type), info.flipped_axes);
-    write_file_atomically(ex.path, data.data(), ex.bytes);   // every write, fsync and close checked
+    // A reversed z hands the stored layers out from the top: source slab [k0, k1) is stored
+    // layers [nz - k1, nz - k0), reversed within the slab.
+    const Dims d = info.dims;
+    const uint64_t layer = uint64_t(d.x) * d.y * scalar_type_bytes(info.type);
+    const uint32_t per_slab = uint32_t(std::clamp<uint64_t>(extract_slab_bytes() / layer, 1, d.z));
+    std::vector<std::byte> slab(size_t(layer * per_slab));
+    const std::endian order = ex.big_endian ? std::endian::big : std::endian::little;
+    const bool z_reversed = info.flipped_axes & 4;
+    AtomicFileWriter out(ex.path);
+    for (uint32_t k0 = 0; k0 < d.z; k0 += per_slab) {
+        const uint32_t k1 = std::min(d.z, k0 + per_slab), n = k1 - k0;
+        const std::span<std::byte> part(slab.data(), size_t(layer * n));
+        if (z_reversed) step.decode_layers(d.z - k1, d.z - k0, part, order);
+        else step.decode_layers(k0, k1, part, order);
+        file->check_unchanged();   // issue 18: the decoded data came from what was validated
+        if (info.flipped_axes) reverse_axes_in_place(part.data(), d, n, scalar_type_bytes(info.type), info.flipped_axes);
+        out.append(part.data(), part.size());
+    }
+    out.commit();   // every write, fsync and close checked
 }
 
 /// "x, z (NIfTI affine negative)" for a flipped-axes mask.

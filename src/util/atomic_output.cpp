@@ -192,22 +192,32 @@ void AtomicOutput::commit(int64_t expected_bytes) {
     }
 }
 
+AtomicFileWriter::AtomicFileWriter(const std::string& path) : out_(path) {
+    fd_ = ::open(out_.temp_path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd_ < 0) throw Error(out_.temp_path(), "cannot create: " + errno_text(), ErrorKind::Other);
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+    if (fd_ >= 0) ::close(fd_);   // uncommitted: out_ removes the temporary
+}
+
+void AtomicFileWriter::append(const void* data, uint64_t bytes) {
+    if (!io::write_all(fd_, data, bytes)) throw Error(out_.path(), "write failed: " + errno_text(), ErrorKind::Other);
+    written_ += bytes;
+}
+
+void AtomicFileWriter::commit() {
+    if (::fsync(fd_) != 0) throw Error(out_.path(), "sync failed: " + errno_text(), ErrorKind::Other);
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) throw Error(out_.path(), "close failed: " + errno_text(), ErrorKind::Other);
+    out_.commit(int64_t(written_));
+}
+
 void write_file_atomically(const std::string& path, const void* data, uint64_t bytes) {
-    AtomicOutput out(path);
-    const int fd = ::open(out.temp_path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd < 0) throw Error(out.temp_path(), "cannot create: " + errno_text(), ErrorKind::Other);
-    if (!io::write_all(fd, data, bytes)) {
-        const std::string e = errno_text();
-        ::close(fd);
-        throw Error(path, "write failed: " + e, ErrorKind::Other);
-    }
-    if (::fsync(fd) != 0) {
-        const std::string e = errno_text();
-        ::close(fd);
-        throw Error(path, "sync failed: " + e, ErrorKind::Other);
-    }
-    if (::close(fd) != 0) throw Error(path, "close failed: " + errno_text(), ErrorKind::Other);
-    out.commit(int64_t(bytes));
+    AtomicFileWriter out(path);
+    out.append(data, bytes);
+    out.commit();
 }
 
 }  // namespace octiso

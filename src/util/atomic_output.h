@@ -38,6 +38,24 @@ private:
     bool committed_ = false;
 };
 
+/// An output file written piece by piece through AtomicOutput (octiso-info --extract-raw of a
+/// step larger than memory): append() in order, then commit(); dropped uncommitted, nothing is
+/// left under the name. Every write, the fsync and the close are checked (ENOSPC names the file).
+class AtomicFileWriter {
+public:
+    explicit AtomicFileWriter(const std::string& path);
+    ~AtomicFileWriter();
+    AtomicFileWriter(const AtomicFileWriter&) = delete;
+    AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+    void append(const void* data, uint64_t bytes);
+    void commit();   ///< fsync, close, rename: the file holds exactly the bytes appended
+
+private:
+    AtomicOutput out_;
+    int fd_ = -1;
+    uint64_t written_ = 0;
+};
+
 /// Writes `bytes` bytes at `data` to `path` through AtomicOutput with every write, the fsync and
 /// the close checked (ENOSPC names the file, exit 1); nothing is left on failure.
 void write_file_atomically(const std::string& path, const void* data, uint64_t bytes);
