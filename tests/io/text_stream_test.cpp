@@ -408,6 +408,31 @@ TEST(TextStream, DamagedCompressedDataIsRefusedWithNoOutput) {
     }
 }
 
+TEST(TextStream, HostileSizesAreOneClearError) {
+    ScratchDir dir("text_hostile");
+    const std::pair<std::string, std::string> cases[] = {
+        {"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 99999999999 2 2\nencoding: raw\n\n", "outside 1.."},
+        {"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 12 -3 2\nencoding: raw\n\n", "not positive integers"},
+        {"NRRD0004\ntype: float\ndimension: 3\nsizes: 1073741824 1073741824 1073741824\nencoding: gzip\nendian: little\n\n",
+         "overflows a 64-bit byte count"},
+        {"ObjectType = Image\nNDims = 3\nDimSize = 12 0 2\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n", "outside 1.."},
+    };
+    int i = 0;
+    for (const auto& [header, expect] : cases) {
+        const std::string path = dir.file(header[0] == 'N' ? "h" + std::to_string(i++) + ".nrrd" : "h" + std::to_string(i++) + ".mha");
+        spit(path, header + std::string(64, 'x'));
+        try {
+            convert(ConvertSource::file(path), dir.file("o.oct"), BuildOptions{}, streamed(4));
+            ADD_FAILURE() << header << ": accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.exit_status(), 2) << e.what();
+            EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        }
+        EXPECT_FALSE(std::filesystem::exists(dir.file("o.oct")));
+    }
+}
+
 TEST(TextStream, HeaderSizePastTheFileIsOneClearError) {
     ScratchDir dir("text_skip_bad");
     const TypeCase& t = kTypes[0];
