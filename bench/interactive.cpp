@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -17,6 +19,7 @@
 #include "bench/peers_mesh.h"
 #include "octiso/any_octree.h"
 #include "octiso/error.h"
+#include "octiso/oct_file.h"
 #include "octiso/reader.h"
 #include "octiso/synthetic.h"
 
@@ -35,10 +38,11 @@ namespace {
 const char* const kInteractiveUsage =
     "usage: octiso-bench interactive [--datasets SPEC,...] [--sizes 512,1024] [--changes N] [--threads N]\n"
     "                                [--no-mesh] [--quick] [--shadows] [--ao N]\n"
-    "  SPEC: a volume file (default /usr/share/mricron/templates/ch2better.nii.gz) or NAME:N (synthetic);\n"
+    "  SPEC: a volume file (default /usr/share/mricron/templates/ch2better.nii.gz), NAME:N (synthetic) or an\n"
+    "  existing .oct (opened as octiso-view opens it; e.g. the 2048x2048x1920 step of octiso-bench outofcore);\n"
     "  default datasets ch2better and marschner-lobb:256 (--quick: marschner-lobb:64 for the synthetic);\n"
     "  --changes isovalue changes per size (default 60, --quick 4), --threads render threads (default 2);\n"
-    "  mesh: median of 3 isovalues (--quick: 1).\n"
+    "  mesh: median of 3 isovalues (--quick: 1); not run where the dense array exceeds a quarter of the RAM.\n"
     "  Latency: GET /frame sent -> RGBA frame received (the page's loopback format), p50 and p95; mesh: extraction + BVH per change;\n"
     "  orbit: --changes azimuth steps at a third of the side (the page's drag frames), frames/s back to back;\n"
     "  --shadows, --ao N: every frame with the page's look toggles (the light kit with shadow / N AO rays per hit;\n"
@@ -51,6 +55,7 @@ struct Row {
     int side = 0, changes = 0;
     double p50_ms = 0, p95_ms = 0, render_p50_ms = 0, max_ms = 0;
     double mesh_extract_ms = 0, mesh_bvh_ms = 0;
+    std::string mesh_skipped = {};          ///< why the mesh path was not run, if it was not
     uint64_t hits_last = 0;
     int preview_side = 0;                  ///< the page's drag frames: a third of the side
     double orbit_fps = 0, orbit_p95_ms = 0;   ///< back-to-back azimuth changes at preview_side
@@ -111,17 +116,20 @@ int run_interactive(cli::Args& args) {
     const auto scratch = std::filesystem::temp_directory_path() / ("octiso-bench-interactive-" + std::to_string(::getpid()));
     std::filesystem::create_directories(scratch);
     for (const std::string& spec : datasets) {
-        // 1. The volume, as a one-step .oct file the viewer opens like any other.
-        const bool synthetic = spec.find(':') != std::string::npos && !std::filesystem::exists(spec);
-        const LoadedVolume volume = synthetic ? make_synthetic(parse_synthetic(spec)) : open_volume(spec, RawOptions{});
+        // 1. The volume, as a one-step .oct file the viewer opens like any other (an existing
+        //    .oct as it is: a volume larger than a dense copy should take is converted out of core).
+        const bool is_oct = spec.size() > 4 && spec.compare(spec.size() - 4, 4, ".oct") == 0;
+        const bool synthetic = !is_oct && spec.find(':') != std::string::npos && !std::filesystem::exists(spec);
+        std::optional<LoadedVolume> volume;
+        if (!is_oct) volume = synthetic ? make_synthetic(parse_synthetic(spec)) : open_volume(spec, RawOptions{});
         const std::string name = synthetic ? spec : std::filesystem::path(spec).filename().string();
-        const std::string oct = (scratch / "bench.oct").string();
-        const AnyOctree tree = AnyOctree::build(volume, BuildOptions{});
-        tree.save(oct);
-        const auto range = tree.info().value_range.value_or(std::array<double, 2>{0, 1});
+        const std::string oct = is_oct ? spec : (scratch / "bench.oct").string();
+        const AnyOctree tree = is_oct ? AnyOctree::open(spec, 0, Verify::Touched) : AnyOctree::build(*volume, BuildOptions{});
+        if (!is_oct) tree.save(oct);
+        const auto range = tree.value_range().value_or(std::array<double, 2>{0, 1});
         // Isovalues of a drag along the slider: around the dataset's usual surface (ch2: the
         // white/grey matter boundary; a synthetic: the middle of its range), each request a change.
-        const double centre = synthetic ? (range[0] + range[1]) / 2 : default_isovalue(name);
+        const double centre = synthetic || is_oct ? (range[0] + range[1]) / 2 : default_isovalue(name);
         const double stride = (range[1] - range[0]) / 400;
         auto iso_of = [&](int i) { return centre + stride * double((i % 20) - 10); };
 
@@ -192,26 +200,41 @@ int run_interactive(cli::Args& args) {
                 rows.push_back(row);
             }
         }
-        // 3. The mesh path for the same changes: extraction + BVH (median of 3 isovalues, 1 with --quick).
-        if (!no_mesh) {
+        // 3. The mesh path for the same changes: extraction + BVH (median of 3 isovalues, 1 with
+        //    --quick), on the dense array (decoded from an .oct), where it fits beside its mesh.
+        std::string mesh_skipped;
+        const uint64_t ram = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
+        if (!no_mesh && tree.dense_bytes() > ram / 4)
+            mesh_skipped = "the dense array (" + fmt(double(tree.dense_bytes()) / double(1 << 30), 1) +
+                           " GiB) exceeds a quarter of the RAM, before its mesh and BVH";
+        if (!no_mesh && mesh_skipped.empty() && !volume) {
+            auto dense = std::make_shared<std::vector<std::byte>>(size_t(tree.dense_bytes()));
+            tree.decode(*dense);
+            const std::byte* data = dense->data();
+            volume.emplace(std::move(dense), data, tree.type(), tree.dims(), tree.placement(), false, spec, VolumeFormat::raw);
+        }
+        if (!no_mesh && mesh_skipped.empty()) {
             std::vector<double> extract, bvh;
             MeshPeerOptions mesh_options;
             mesh_options.threads = threads;
             for (int i = 0; i < (quick ? 1 : 3); ++i) {
-                const Camera camera = orbit_camera(volume.dims(), volume.placement(), 64, 64, kDefaultAzimuthDeg, kDefaultElevationDeg);
-                const MeshPeerResult m = run_mesh_peer(volume, iso_of(i * 7), camera, mesh_options);
+                const Camera camera = orbit_camera(volume->dims(), volume->placement(), 64, 64, kDefaultAzimuthDeg, kDefaultElevationDeg);
+                const MeshPeerResult m = run_mesh_peer(*volume, iso_of(i * 7), camera, mesh_options);
                 extract.push_back(m.extract_seconds * 1e3);
                 bvh.push_back(m.bvh_seconds * 1e3);
             }
             for (Row& r : rows)
                 if (r.dataset == name) r.mesh_extract_ms = percentile(extract, 0.5), r.mesh_bvh_ms = percentile(bvh, 0.5);
         }
-        std::filesystem::remove(oct);
+        for (Row& r : rows)
+            if (r.dataset == name) r.mesh_skipped = mesh_skipped;
+        if (!is_oct) std::filesystem::remove(oct);
     }
     std::filesystem::remove_all(scratch);
     for (const Row& r : rows)
         table.add({r.dataset, std::to_string(r.side) + "^2", std::to_string(r.changes), fmt(r.p50_ms, 1), fmt(r.p95_ms, 1),
-                   fmt(r.max_ms, 1), fmt(r.render_p50_ms, 1), no_mesh ? "-" : fmt(r.mesh_extract_ms, 1), no_mesh ? "-" : fmt(r.mesh_bvh_ms, 1),
+                   fmt(r.max_ms, 1), fmt(r.render_p50_ms, 1), no_mesh || !r.mesh_skipped.empty() ? "-" : fmt(r.mesh_extract_ms, 1),
+                   no_mesh || !r.mesh_skipped.empty() ? "-" : fmt(r.mesh_bvh_ms, 1),
                    std::to_string(r.preview_side) + "^2", fmt(r.orbit_fps, 1), fmt(r.orbit_p95_ms, 1)});
     // The machine is shared: the 1-minute load average at the end says how much others ran meanwhile.
     double load = -1;
@@ -223,6 +246,8 @@ int run_interactive(cli::Args& args) {
               << (look.empty() ? "" : ", look" + std::string(shadows ? " shadows" : "") + (ao > 0 ? " ao " + std::to_string(ao) : "")) << " ("
               << machine_description() << "; load average " << fmt(load, 2) << ")\n";
     table.print(std::cout);
+    for (const Row& r : rows)
+        if (!r.mesh_skipped.empty() && r.side == sides.front()) std::cout << r.dataset << ": mesh path not run: " << r.mesh_skipped << "\n";
     const std::string path = write_json(results, "interactive", [&](cli::JsonWriter& j) {
         j.begin_object();
         j.field("threads", int64_t(threads)).field("changes", int64_t(changes)).field("machine", machine_description());
@@ -233,7 +258,8 @@ int run_interactive(cli::Args& args) {
             j.field("p95_ms", r.p95_ms).field("max_ms", r.max_ms).field("render_p50_ms", r.render_p50_ms);
             j.field("hits_last_frame", r.hits_last).field("orbit_preview_side", int64_t(r.preview_side));
             j.field("orbit_fps", r.orbit_fps).field("orbit_p95_ms", r.orbit_p95_ms);
-            if (!no_mesh) j.field("mesh_extract_ms", r.mesh_extract_ms).field("mesh_bvh_ms", r.mesh_bvh_ms);
+            if (!no_mesh && r.mesh_skipped.empty()) j.field("mesh_extract_ms", r.mesh_extract_ms).field("mesh_bvh_ms", r.mesh_bvh_ms);
+            if (!r.mesh_skipped.empty()) j.field("mesh_skipped", r.mesh_skipped);
             j.end_object();
         }
         j.end_array();

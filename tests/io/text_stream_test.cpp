@@ -109,6 +109,21 @@ MemoryOptions streamed(uint32_t side) {
     return m;
 }
 
+/// Converting `in` (in memory or under a budget) fails with exit 2, a message holding every
+/// string of `expect`, and no output file.
+void expect_refused(ScratchDir& dir, const std::string& in, const MemoryOptions& memory, const std::vector<std::string>& expect,
+                    const std::string& what) {
+    const std::string out = dir.file("refused.oct");
+    try {
+        convert(ConvertSource::file(in), out, BuildOptions{}, memory);
+        ADD_FAILURE() << what << ": accepted";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.exit_status(), 2) << what << ": " << e.what();
+        for (const std::string& x : expect) EXPECT_NE(std::string(e.what()).find(x), std::string::npos) << what << ": " << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(out)) << what;
+}
+
 /// VTK's own reading (read_vtk) must give the placement and, where `vtk_reads_right`, the voxels
 /// written; `in` converted in memory and out of core must give the same .oct bytes, and those
 /// must decode to the voxels written.
@@ -201,16 +216,8 @@ TEST(TextStream, NrrdByteSkipIsRefusedByBothPathsAsVtkDoes) {
     spit(dir.file("a.data"), std::string(11, 'j') + data);
     spit(dir.file("a.nhdr"), nrrd_head(t, d, false, "raw", "data file: a.data\nbyte skip: 11\n"));
     EXPECT_NE(text_stream_refusal(dir.file("a.nhdr"), VolumeFormat::nrrd).value_or("").find("byte skip"), std::string::npos);
-    for (const bool budget : {false, true}) {
-        try {
-            convert(ConvertSource::file(dir.file("a.nhdr")), dir.file("a.oct"), BuildOptions{}, budget ? streamed(4) : MemoryOptions{});
-            ADD_FAILURE() << "accepted";
-        } catch (const Error& e) {
-            EXPECT_EQ(e.exit_status(), 2);
-            EXPECT_NE(std::string(e.what()).find("byte skip"), std::string::npos) << e.what();
-        }
-        EXPECT_FALSE(std::filesystem::exists(dir.file("a.oct")));
-    }
+    for (const bool budget : {false, true})
+        expect_refused(dir, dir.file("a.nhdr"), budget ? streamed(4) : MemoryOptions{}, {"byte skip"}, "byte skip");
 }
 
 std::string meta_head(const TypeCase& t, Dims d, bool big, bool compressed, const std::string& data_file,
@@ -322,16 +329,8 @@ TEST(TextStream, BadAsciiValuesAreOneClearError) {
     for (const auto& [text, expect] : cases) {
         ScratchDir dir("nrrd_ascii_bad");
         spit(dir.file("a.nrrd"), nrrd_head(t, d, false, "ascii", "") + "\n" + text + "\n");
-        for (const bool budget : {false, true}) {
-            try {
-                convert(ConvertSource::file(dir.file("a.nrrd")), dir.file("a.oct"), BuildOptions{}, budget ? streamed(4) : MemoryOptions{});
-                ADD_FAILURE() << text << ": accepted";
-            } catch (const Error& e) {
-                EXPECT_EQ(e.exit_status(), 2);
-                EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
-            }
-            EXPECT_FALSE(std::filesystem::exists(dir.file("a.oct")));
-        }
+        for (const bool budget : {false, true})
+            expect_refused(dir, dir.file("a.nrrd"), budget ? streamed(4) : MemoryOptions{}, {expect}, text);
     }
 }
 
@@ -393,15 +392,7 @@ TEST(TextStream, DamagedCompressedDataIsRefusedWithNoOutput) {
         ScratchDir dir("text_damaged");
         spit(dir.file("v.data"), c.payload);
         spit(dir.file("v.nhdr"), nrrd_head(t, d, false, "gzip", "data file: v.data\n"));
-        try {
-            convert(ConvertSource::file(dir.file("v.nhdr")), dir.file("v.oct"), BuildOptions{}, streamed(4));
-            ADD_FAILURE() << c.name << ": accepted";
-        } catch (const Error& e) {
-            EXPECT_EQ(e.exit_status(), 2) << c.name;
-            EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << c.name << ": " << e.what();
-            EXPECT_NE(std::string(e.what()).find("v.data"), std::string::npos) << c.name << ": " << e.what();
-        }
-        EXPECT_FALSE(std::filesystem::exists(dir.file("v.oct"))) << c.name;
+        expect_refused(dir, dir.file("v.nhdr"), streamed(4), {c.expect, "v.data"}, c.name);
         for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
             EXPECT_TRUE(entry.path().filename() == "v.data" || entry.path().filename() == "v.nhdr")
                 << c.name << ": left " << entry.path();
@@ -421,15 +412,7 @@ TEST(TextStream, HostileSizesAreOneClearError) {
     for (const auto& [header, expect] : cases) {
         const std::string path = dir.file(header[0] == 'N' ? "h" + std::to_string(i++) + ".nrrd" : "h" + std::to_string(i++) + ".mha");
         spit(path, header + std::string(64, 'x'));
-        try {
-            convert(ConvertSource::file(path), dir.file("o.oct"), BuildOptions{}, streamed(4));
-            ADD_FAILURE() << header << ": accepted";
-        } catch (const Error& e) {
-            EXPECT_EQ(e.exit_status(), 2) << e.what();
-            EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
-            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-        }
-        EXPECT_FALSE(std::filesystem::exists(dir.file("o.oct")));
+        expect_refused(dir, path, streamed(4), {expect, path}, header);
     }
 }
 
