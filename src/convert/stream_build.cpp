@@ -309,13 +309,17 @@ StreamPlan plan_stream(Dims dims, ScalarType type, const BuildOptions& options, 
             throw Error("--piece-side", "must be a power of two >= 4, found " + std::to_string(forced_side));
         p.piece_side = std::min(forced_side, top_side);
     } else {
+        // The largest side whose need leaves half the budget to the spill store; if none does,
+        // the side that needs least (smaller pieces shrink the slab but add per-piece
+        // summaries for the whole volume: at 3072^2 layers 16^3 needs 1.1 GiB, 4^3 30 GiB).
         const uint32_t largest = std::min(kMaxPieceSide, top_side);
-        p.piece_side = kMinPieceSide;
-        for (uint32_t s = largest; s > kMinPieceSide; s /= 2)
-            if (need(s) <= double(budget) / 2) {
-                p.piece_side = s;
-                break;
-            }
+        p.piece_side = 0;
+        uint32_t cheapest = largest;
+        for (uint32_t s = largest; s >= kMinPieceSide; s /= 2) {
+            if (need(s) < need(cheapest)) cheapest = s;
+            if (!p.piece_side && need(s) <= double(budget) / 2) p.piece_side = s;
+        }
+        if (!p.piece_side) p.piece_side = cheapest;
     }
     const double total = slab_need(dims, b, options, p.piece_side, is_float) + fixed_need(dims, b, p.piece_side);
     if (total > double(budget))

@@ -210,6 +210,29 @@ TEST(StreamBuild, BudgetTooSmallForOneSlabIsRefusedBeforeAnyWork) {
     EXPECT_EQ(dir.entries(), std::vector<std::string>{"in.raw"});
 }
 
+// Wide layers (3072^2, the larger-than-RAM benchmark): no side leaves half of 2 GiB to the
+// spill store, so the plan takes the side that needs least (16: smaller pieces add per-piece
+// summaries for the whole volume, larger ones a bigger slab) instead of the smallest side,
+// whose 768^3 pieces would need 30 GiB; and 1 GiB is refused naming what the cheapest needs.
+TEST(StreamBuild, WideLayersTakeTheSideThatNeedsLeast) {
+    const Dims d{3072, 3072, 3072};
+    const convert_detail::StreamPlan p =
+        convert_detail::plan_stream(d, ScalarType::u8, BuildOptions{}, uint64_t(2) << 30, 0, "wide.raw");
+    EXPECT_EQ(p.piece_side, 16u);
+    EXPECT_LE(p.slab_bytes + p.fixed_bytes, uint64_t(2) << 30);
+    for (uint32_t side : {4u, 8u, 32u, 64u}) {
+        const convert_detail::StreamPlan q =
+            convert_detail::plan_stream(d, ScalarType::u8, BuildOptions{}, uint64_t(64) << 30, side, "wide.raw");
+        EXPECT_GT(q.slab_bytes + q.fixed_bytes, p.slab_bytes + p.fixed_bytes) << side;
+    }
+    try {
+        convert_detail::plan_stream(d, ScalarType::u8, BuildOptions{}, uint64_t(1) << 30, 0, "wide.raw");
+        ADD_FAILURE() << "1 GiB accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("one slab of 16 layers"), std::string::npos) << e.what();
+    }
+}
+
 TEST(StreamBuild, FailureInALaterStepLeavesNoTemporaries) {
     const Dims d{12, 12, 40};
     ScratchDir dir("stream_fail");
