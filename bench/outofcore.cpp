@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <vector>
 
 #include <fcntl.h>
@@ -29,11 +30,12 @@ namespace {
 
 const char* const kOutOfCoreUsage =
     "usage: octiso-bench outofcore [--dims NX,NY,NZ] [--memory BYTES] [--dir DIR] [--threads N] [--keep]\n"
-    "                              [--streamed-only] [--quick]\n"
+    "                              [--streamed-only] [--quick] | --frames-of FILE.oct [--iso V]\n"
     "  u8 NX*NY*NZ (default 1024,1024,1024) written once to DIR (default $TMPDIR) as outofcore_NXxNYxNZ.raw and\n"
     "  reused; converted with --memory (default 1G) and --in-memory; --keep keeps the input for the next run.\n"
     "  --streamed-only: no in-memory run (an input larger than RAM), and the input is removed once hashed and\n"
-    "  converted (unless --keep), so that the extracted copy fits on the disk beside the .oct";
+    "  converted (unless --keep), so that the extracted copy fits on the disk beside the .oct.\n"
+    "  --frames-of FILE.oct [--iso V]: only the cold frames (afar, close; --verify full, touched) of that file";
 
 /// The value of voxel (x, y, z): nested shells and slow waves, so the octree has structure at
 /// every depth (about as compressible as the paper's scans). The formula, once per voxel:
@@ -142,6 +144,74 @@ void evict(const std::string& path) {
     ::close(fd);
 }
 
+/// A 512^2 frame (--quick: 64^2) of `oct` at `iso`, afar (the default camera: the whole data)
+/// and close up (zoom 8: a corner of it), under --verify full and touched, each from a cold
+/// page cache, interleaved.
+std::vector<RenderRow> cold_frames(const std::string& oct, const std::string& iso, bool quick,
+                                   const std::optional<std::string>& threads, const std::string& image) {
+    std::vector<RenderRow> renders;
+    for (const char* view : {"afar", "close"})
+        for (const char* verify : {"full", "touched"}) {
+            evict(oct);
+            std::vector<std::string> args{oct, "--iso", iso, "--size", quick ? "64x64" : "512x512", "--verify", verify, "--json", "-o", image};
+            if (std::string(view) == "close") args.insert(args.end(), {"--zoom", "8"});
+            if (threads) args.insert(args.end(), {"--threads", *threads});
+            const std::string json = run_tool("octiso-render", args);
+            RenderRow r{verify, view};
+            r.open_to_first_frame = json_number(json, "open_to_first_frame_seconds");
+            r.frame_seconds = json_number(json, "frame_seconds");
+            r.resident = uint64_t(json_number(json, "file_resident_bytes"));
+            r.hits = uint64_t(json_number(json, "hits"));
+            if (std::string(verify) == "touched") {
+                r.blocks = uint64_t(json_number(json, "blocks"));
+                r.checked = uint64_t(json_number(json, "checked"));
+            }
+            renders.push_back(r);
+        }
+    std::error_code ec;
+    std::filesystem::remove(image, ec);
+    return renders;
+}
+
+void print_frames(const std::vector<RenderRow>& renders, uint64_t file_bytes) {
+    Table frames({"view", "--verify", "open to first frame s", "frame s", "file resident MiB", "% of file", "blocks checked", "hits"});
+    for (const RenderRow& r : renders)
+        frames.add({r.view, r.verify, fmt(r.open_to_first_frame, 2), fmt(r.frame_seconds, 2), fmt(mib(r.resident), 1),
+                    fmt(100.0 * double(r.resident) / double(std::max<uint64_t>(1, file_bytes)), 1),
+                    r.verify == "touched" ? std::to_string(r.checked) + " / " + std::to_string(r.blocks) : "-", std::to_string(r.hits)});
+    frames.print(std::cout);
+}
+
+void json_frames(cli::JsonWriter& j, const std::vector<RenderRow>& renders) {
+    j.key("frames").begin_array();
+    for (const RenderRow& r : renders) {
+        j.begin_object().field("view", r.view).field("verify", r.verify).field("open_to_first_frame_seconds", r.open_to_first_frame);
+        j.field("frame_seconds", r.frame_seconds).field("file_resident_bytes", r.resident).field("hits", r.hits);
+        j.field("blocks", r.blocks).field("blocks_checked", r.checked).end_object();
+    }
+    j.end_array();
+}
+
+/// --frames-of FILE.oct: only the cold frames of an existing file (issue 13 names the 1.84 GiB
+/// RM-like step, octiso-convert --synthetic mixing:2048,2048,1920).
+int frames_of(const std::string& oct, const std::string& iso, bool quick, const std::optional<std::string>& threads,
+              const std::string& results) {
+    const uint64_t file_bytes = std::filesystem::file_size(oct);
+    const std::string stem = std::filesystem::path(oct).stem().string();
+    const std::vector<RenderRow> renders =
+        cold_frames(oct, iso, quick, threads, (std::filesystem::temp_directory_path() / (stem + "_frame.png")).string());
+    std::cout << "one frame of " << oct << " (" << fmt(mib(file_bytes), 1) << " MiB), iso " << iso << ", cold page cache ("
+              << machine_description() << "):\n";
+    print_frames(renders, file_bytes);
+    const std::string path = write_json(results, "outofcore_frames_" + stem, [&](cli::JsonWriter& j) {
+        j.begin_object().field("file", oct).field("file_bytes", file_bytes).field("iso", iso).field("machine", machine_description());
+        json_frames(j, renders);
+        j.end_object();
+    });
+    std::cout << "wrote " << path << "\n";
+    return 0;
+}
+
 int run_outofcore(cli::Args& args) {
     if (args.flag("--help")) {
         std::cout << kOutOfCoreUsage << "\n";
@@ -150,8 +220,10 @@ int run_outofcore(cli::Args& args) {
     const bool quick = args.flag("--quick"), keep = args.flag("--keep"), streamed_only = args.flag("--streamed-only");
     const auto dims_flag = args.value("--dims"), memory_flag = args.value("--memory");
     const auto dir_flag = args.value("--dir"), threads_flag = args.value("--threads");
+    const auto frames_flag = args.value("--frames-of"), iso_flag = args.value("--iso");
     const std::string results = results_dir(args);
     args.finish();
+    if (frames_flag) return frames_of(*frames_flag, iso_flag.value_or("98"), quick, threads_flag, results);
     const Dims d = dims_flag ? parse_dims(*dims_flag, "--dims") : quick ? Dims{160, 144, 130} : Dims{1024, 1024, 1024};
     const std::string memory = memory_flag ? *memory_flag : quick ? "4M" : "1G";
     const std::string dir = dir_flag ? *dir_flag : std::filesystem::temp_directory_path().string();
@@ -203,29 +275,8 @@ int run_outofcore(cli::Args& args) {
     const std::string a = dir + "/outofcore_" + tag + "_streamed.oct", b = dir + "/outofcore_" + tag + "_in_memory.oct";
     const bool identical = !streamed_only && same_files(a, b);
 
-    // 3. A 512^2 frame of the file, afar (the whole data) and close up (zoom 8: a corner of it),
-    //    under --verify full and touched, each from a cold cache, interleaved.
-    std::vector<RenderRow> renders;
-    const std::string image = dir + "/outofcore_" + tag + "_frame.png";
-    for (const char* view : {"afar", "close"})
-        for (const char* verify : {"full", "touched"}) {
-            evict(a);
-            std::vector<std::string> args{a, "--iso", "98", "--size", quick ? "64x64" : "512x512", "--verify", verify, "--json", "-o", image};
-            if (std::string(view) == "close") args.insert(args.end(), {"--zoom", "8"});
-            if (threads_flag) args.insert(args.end(), {"--threads", *threads_flag});
-            const std::string json = run_tool("octiso-render", args);
-            RenderRow r{verify, view};
-            r.open_to_first_frame = json_number(json, "open_to_first_frame_seconds");
-            r.frame_seconds = json_number(json, "frame_seconds");
-            r.resident = uint64_t(json_number(json, "file_resident_bytes"));
-            r.hits = uint64_t(json_number(json, "hits"));
-            if (std::string(verify) == "touched") {
-                r.blocks = uint64_t(json_number(json, "blocks"));
-                r.checked = uint64_t(json_number(json, "checked"));
-            }
-            renders.push_back(r);
-        }
-    std::filesystem::remove(image, ec);
+    // 3. A 512^2 frame of the file, afar and close up, --verify full and touched, cold.
+    const std::vector<RenderRow> renders = cold_frames(a, "98", quick, threads_flag, dir + "/outofcore_" + tag + "_frame.png");
     std::filesystem::remove(a, ec);
     std::filesystem::remove(b, ec);
     if (!keep) std::filesystem::remove(input, ec);
@@ -245,12 +296,7 @@ int run_outofcore(cli::Args& args) {
         std::cout << "the two .oct files are " << (identical ? "identical, byte for byte" : "DIFFERENT") << "; throughput "
                   << fmt(100.0 * rows[0].mvoxels_per_second / rows[1].mvoxels_per_second, 1) << " % of in-memory\n";
     std::cout << "one frame of the " << fmt(mib(rows[0].file_bytes), 1) << " MiB file, cold page cache:\n";
-    Table frames({"view", "--verify", "open to first frame s", "frame s", "file resident MiB", "% of file", "blocks checked", "hits"});
-    for (const RenderRow& r : renders)
-        frames.add({r.view, r.verify, fmt(r.open_to_first_frame, 2), fmt(r.frame_seconds, 2), fmt(mib(r.resident), 1),
-                    fmt(100.0 * double(r.resident) / double(std::max<uint64_t>(1, rows[0].file_bytes)), 1),
-                    r.verify == "touched" ? std::to_string(r.checked) + " / " + std::to_string(r.blocks) : "-", std::to_string(r.hits)});
-    frames.print(std::cout);
+    print_frames(renders, rows[0].file_bytes);
     const std::string path = write_json(results, quick ? "outofcore" : "outofcore_" + tag, [&](cli::JsonWriter& j) {
         j.begin_object();
         j.field("dims", tag).field("type", std::string("u8")).field("input_bytes", voxels).field("memory", memory);
@@ -265,13 +311,7 @@ int run_outofcore(cli::Args& args) {
             j.field("spilled_bytes", r.spilled).field("piece_side", r.piece_side).field("lossless", r.lossless).end_object();
         }
         j.end_array();
-        j.key("frames").begin_array();
-        for (const RenderRow& r : renders) {
-            j.begin_object().field("view", r.view).field("verify", r.verify).field("open_to_first_frame_seconds", r.open_to_first_frame);
-            j.field("frame_seconds", r.frame_seconds).field("file_resident_bytes", r.resident).field("hits", r.hits);
-            j.field("blocks", r.blocks).field("blocks_checked", r.checked).end_object();
-        }
-        j.end_array();
+        json_frames(j, renders);
         j.end_object();
     });
     std::cout << "wrote " << path << "\n";
