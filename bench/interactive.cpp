@@ -6,6 +6,7 @@
 // request, render, the RGBA widening, transfer; the browser's canvas and paint are not in it
 // (bench/interactive_browser.py measures those).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -46,7 +47,8 @@ const char* const kInteractiveUsage =
     "  Latency: GET /frame sent -> RGBA frame received (the page's loopback format), p50 and p95; mesh: extraction + BVH per change;\n"
     "  orbit: --changes azimuth steps at a third of the side (the page's drag frames), frames/s back to back;\n"
     "  --shadows, --ao N: every frame with the page's look toggles (the light kit with shadow / N AO rays per hit;\n"
-    "  the orbit's drag frames skip AO, as the page's do).";
+    "  the orbit's drag frames skip AO, as the page's do).\n"
+    "  JSON: interactive.json, or interactive_NAME_NAME.json for a --datasets list.";
 
 #ifdef OCTISO_HAVE_VIEW
 
@@ -248,7 +250,18 @@ int run_interactive(cli::Args& args) {
     table.print(std::cout);
     for (const Row& r : rows)
         if (!r.mesh_skipped.empty() && r.side == sides.front()) std::cout << r.dataset << ": mesh path not run: " << r.mesh_skipped << "\n";
-    const std::string path = write_json(results, "interactive", [&](cli::JsonWriter& j) {
+    // interactive.json for the default datasets; interactive_<names>.json for a --datasets list,
+    // so a run on other data keeps the default run's file.
+    std::string json_name = "interactive";
+    if (datasets_flag)
+        for (const std::string& spec : datasets) {
+            std::string stem = std::filesystem::path(spec).stem().string();
+            if (stem.size() > 4 && stem.compare(stem.size() - 4, 4, ".nii") == 0) stem.resize(stem.size() - 4);
+            for (char& c : stem)
+                if (!std::isalnum((unsigned char)c)) c = '-';
+            json_name += "_" + stem;
+        }
+    const std::string path = write_json(results, json_name, [&](cli::JsonWriter& j) {
         j.begin_object();
         j.field("threads", int64_t(threads)).field("changes", int64_t(changes)).field("machine", machine_description());
         j.field("load_average_1min", load).field("shadows", shadows).field("ao", int64_t(ao));
