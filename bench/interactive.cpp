@@ -38,12 +38,13 @@ namespace {
 
 const char* const kInteractiveUsage =
     "usage: octiso-bench interactive [--datasets SPEC,...] [--sizes 512,1024] [--changes N] [--threads N]\n"
-    "                                [--no-mesh] [--quick] [--shadows] [--ao N]\n"
+    "                                [--no-mesh] [--mesh-up-to-gib G] [--quick] [--shadows] [--ao N]\n"
     "  SPEC: a volume file (default /usr/share/mricron/templates/ch2better.nii.gz), NAME:N (synthetic) or an\n"
-    "  existing .oct (opened as octiso-view opens it; e.g. the 2048x2048x1920 step of octiso-bench outofcore);\n"
+    "  existing .oct (opened as octiso-view opens it; e.g. octiso-convert --synthetic mixing:2048,2048,1920);\n"
     "  default datasets ch2better and marschner-lobb:256 (--quick: marschner-lobb:64 for the synthetic);\n"
     "  --changes isovalue changes per size (default 60, --quick 4), --threads render threads (default 2);\n"
-    "  mesh: median of 3 isovalues (--quick: 1); not run where the dense array exceeds a quarter of the RAM.\n"
+    "  mesh: median of 3 isovalues (--quick: 1); not run where the dense array exceeds G GiB\n"
+    "  (--mesh-up-to-gib, default a quarter of the RAM: the array, its mesh and the BVH are all in memory at once).\n"
     "  Latency: GET /frame sent -> RGBA frame received (the page's loopback format), p50 and p95; mesh: extraction + BVH per change;\n"
     "  orbit: --changes azimuth steps at a third of the side (the page's drag frames), frames/s back to back;\n"
     "  --shadows, --ao N: every frame with the page's look toggles (the light kit with shadow / N AO rays per hit;\n"
@@ -85,7 +86,7 @@ int run_interactive(cli::Args& args) {
         return 0;
     }
     const bool quick = args.flag("--quick"), no_mesh = args.flag("--no-mesh"), shadows = args.flag("--shadows");
-    const auto ao_flag = args.value("--ao");
+    const auto ao_flag = args.value("--ao"), mesh_limit_flag = args.value("--mesh-up-to-gib");
     const auto datasets_flag = args.value("--datasets"), sizes_flag = args.value("--sizes");
     const auto changes_flag = args.value("--changes"), threads_flag = args.value("--threads");
     const std::string results = results_dir(args);
@@ -205,10 +206,11 @@ int run_interactive(cli::Args& args) {
         // 3. The mesh path for the same changes: extraction + BVH (median of 3 isovalues, 1 with
         //    --quick), on the dense array (decoded from an .oct), where it fits beside its mesh.
         std::string mesh_skipped;
-        const uint64_t ram = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
-        if (!no_mesh && tree.dense_bytes() > ram / 4)
-            mesh_skipped = "the dense array (" + fmt(double(tree.dense_bytes()) / double(1 << 30), 1) +
-                           " GiB) exceeds a quarter of the RAM, before its mesh and BVH";
+        const double ram = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
+        const double mesh_limit = mesh_limit_flag ? cli::parse_double(*mesh_limit_flag, "--mesh-up-to-gib") * double(1 << 30) : ram / 4;
+        if (!no_mesh && double(tree.dense_bytes()) > mesh_limit)
+            mesh_skipped = "the dense array (" + fmt(double(tree.dense_bytes()) / double(1 << 30), 1) + " GiB) exceeds " +
+                           (mesh_limit_flag ? "--mesh-up-to-gib" : "a quarter of the RAM") + ", before its mesh and BVH";
         if (!no_mesh && mesh_skipped.empty() && !volume) {
             auto dense = std::make_shared<std::vector<std::byte>>(size_t(tree.dense_bytes()));
             tree.decode(*dense);
