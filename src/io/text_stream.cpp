@@ -1,8 +1,8 @@
 // The NRRD / MetaImage VolumeStream (volume_stream.h): the voxels where text_data_layout() says
 // they are, read with pread (raw), inflated as they are read (gzip or zlib framing: inflate
 // finds which from the first bytes) or parsed (NRRD ascii), so that a file larger than memory
-// costs one slab and a 1 MiB input buffer. Grid, type and placement are VTK's reading of the same header
-// (vtk_information.h): a file the two read differently is left to VTK whole.
+// costs one slab and a 1 MiB input buffer. Grid, type and placement are VTK's reading of the
+// same header (vtk_information.h): a file the two read differently is left to VTK whole.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -10,8 +10,8 @@
 #include <charconv>
 #include <cerrno>
 #include <climits>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <fcntl.h>
 #include <unistd.h>
 #include <vector>
@@ -82,7 +82,7 @@ private:
                 if (done < bytes) {
                     if (z_.avail_in == 0 && !more_input())
                         throw Error(layout_.data_path, "compressed data ends before the voxels the header declares (" +
-                                                  std::to_string(total_out_ + z_.total_out) + " bytes)");
+                                                           std::to_string(total_out_ + z_.total_out) + " bytes)");
                     total_out_ += z_.total_out;
                     ::inflateReset(&z_);
                 }
@@ -156,7 +156,8 @@ private:
             if (separator && !token_.empty()) return token_;
             ++in_at_;
             if (separator) continue;
-            if (token_.size() == 64) throw Error(layout_.data_path, "ascii value " + std::to_string(values_read_ + 1) + " is over 64 characters");
+            if (token_.size() == 64)
+                throw Error(layout_.data_path, "ascii value " + std::to_string(values_read_ + 1) + " is over 64 characters");
             token_ += c;
         }
     }
@@ -211,18 +212,14 @@ private:
     uint64_t values_read_ = 0;
 };
 
-}  // namespace
-
-namespace {
-
 /// The layout and VTK's placement, or why the file is left to VTK.
-struct StreamPlan {
+struct TextStreamPlan {
     std::optional<io::DataLayout> layout;
     Placement placement;
     std::string why_not;
 };
 
-StreamPlan plan_stream(const std::string& path, VolumeFormat format) {
+TextStreamPlan plan_text_stream(const std::string& path, VolumeFormat format) {
     io::LayoutOrReason l = io::text_data_layout(path, format);
     if (!l.layout) return {std::nullopt, {}, std::move(l.why_not)};
     const io::VtkImageInformation vtk = io::read_vtk_information(path, format);
@@ -235,12 +232,12 @@ StreamPlan plan_stream(const std::string& path, VolumeFormat format) {
 }  // namespace
 
 std::optional<std::string> text_stream_refusal(const std::string& path, VolumeFormat format) {
-    StreamPlan plan = plan_stream(path, format);
+    TextStreamPlan plan = plan_text_stream(path, format);
     return plan.layout ? std::nullopt : std::optional<std::string>(std::move(plan.why_not));
 }
 
 std::unique_ptr<VolumeStream> open_text_stream(const std::string& path, VolumeFormat format) {
-    const StreamPlan plan = plan_stream(path, format);
+    const TextStreamPlan plan = plan_text_stream(path, format);
     if (!plan.layout)
         throw Error(path, std::string(volume_format_name(format)) + " input is read whole, not streamed (" + plan.why_not + ")",
                     ErrorKind::Other);
