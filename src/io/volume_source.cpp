@@ -161,8 +161,9 @@ LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
     // VTK applies neither scl_slope nor the sform's flips, and reverses the slices of qfac -1
     // files, so one reader for both paths is what keeps their .oct bytes equal (CONVENTIONS 2b).
     // NRRD and MetaImage likewise wherever the stream reads them (text_stream.cpp): VTK 9.1's
-    // NRRD reader leaves big-endian gzip data unswapped (text_stream_test.cpp shows it), and
-    // VTK still gives the placement. The layouts the stream leaves alone are VTK's.
+    // NRRD reader leaves big-endian gzip data unswapped and reads ascii data as zeros
+    // (text_stream_test.cpp shows both); VTK still gives the placement. The layouts the stream
+    // leaves alone are VTK's.
     const bool text = (format == VolumeFormat::nrrd || format == VolumeFormat::meta_image) && !options.array &&
                       !text_stream_refusal(path, format);
     LoadedVolume volume = format == VolumeFormat::raw

@@ -99,8 +99,9 @@ std::unique_ptr<VolumeStream> open_raw_stream(const std::string& path, Dims dims
 /// oblique affine is placed as VTK does and named in warning().
 std::unique_ptr<VolumeStream> open_nifti_stream(const std::string& path);
 
-/// NRRD (.nrrd, .nhdr) or MetaImage (.mha, .mhd) with raw or gzip/zlib data in one file
-/// (text_stream.cpp): the header's layout (text_layout.h) read with pread or inflated as read,
+/// NRRD (.nrrd, .nhdr) or MetaImage (.mha, .mhd) with raw or gzip/zlib data (or NRRD ascii) in
+/// one file (text_stream.cpp): the header's layout (text_layout.h) read with pread, inflated or
+/// parsed as read,
 /// swapped when big-endian, placed as VTK places it. Throws Error(path, ...) when
 /// text_stream_refusal() gives a reason.
 std::unique_ptr<VolumeStream> open_text_stream(const std::string& path, VolumeFormat format);
