@@ -13,6 +13,7 @@
 #include "octiso/look.h"
 #include "octiso/render.h"
 #include "octiso/shading.h"
+#include "octiso/value_stats.h"
 #include "octiso/volume.h"
 #include "view/png.h"
 #include "view/rgba.h"
@@ -89,7 +90,20 @@ Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_by
     const ValueScale scale = info.value_scale;
     const std::array<double, 2> range = scale.real_range(*info.value_range);
     h.lo = range[0], h.hi = range[1];
-    if (step.dense_bytes() > max_dense_bytes || bins <= 0) return h;
+    if (bins <= 0) return h;
+    if (step.dense_bytes() > max_dense_bytes) {
+        // Too large to decode (the 2048x2048x1920 step is 7.5 GiB dense): the histogram from the
+        // tree (value_stats.h: a scalar leaf counts once for all its voxels, caps voxel by voxel),
+        // in stored-value bins over the voxels' exact range, turned into real values. The
+        // scale is affine, so bins of equal stored width are bins of equal real width; a
+        // negative slope reverses their order.
+        const ValueStats stats = value_stats(step, bins);
+        const std::array<double, 2> real = scale.real_range(stats.range);
+        h.lo = real[0], h.hi = real[1];
+        h.counts = stats.counts;
+        if (scale.slope < 0) std::reverse(h.counts.begin(), h.counts.end());
+        return h;
+    }
     std::vector<std::byte> dense(step.dense_bytes());
     step.decode(dense);
     h.counts.assign(size_t(bins), 0);

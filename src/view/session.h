@@ -88,8 +88,8 @@ private:
 };
 
 /// Step 0's values as real values (its value_scale applied) in `bins` bins over its real value
-/// range; decoded only when the dense array is at most `max_dense_bytes` (else counts is empty:
-/// the page draws no histogram).
+/// range, from the decoded array when it is at most `max_dense_bytes`; else from the tree
+/// (value_stats: the cost of the stored size) over the voxels' exact real range.
 Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_bytes);
 
 /// The octiso-render command line for `camera`, the real isovalue `iso`, `look` (shadows and

@@ -94,6 +94,31 @@ TEST_F(ViewSessionScale, InfoAndHistogramAreInRealValues) {
     EXPECT_GT(h.counts.front(), 0u);
 }
 
+// A step too large to decode (the 2048x2048x1920 step: 7.5 GiB dense) gets its histogram from
+// the tree: forced here with a limit of 0 bytes. Without a scale it is the dense path's, bin for
+// bin; with a negative slope the same voxels over the same real range, in reversed bins (a value
+// on a bin edge may land one bin over, so the test asserts the totals and the ends).
+TEST_F(ViewSessionScale, HistogramFromTheTreeMatchesTheDecodedOne) {
+    write_scaled_oct(nii_, path_, 1.0f, 0.0f);
+    const AnyOctree plain = AnyOctree::open(path_);
+    const Histogram dense = value_histogram(plain, 128, uint64_t(1) << 30), tree = value_histogram(plain, 128, 0);
+    EXPECT_EQ(tree.lo, dense.lo);
+    EXPECT_EQ(tree.hi, dense.hi);
+    EXPECT_EQ(tree.counts, dense.counts);
+
+    write_scaled_oct(nii_, path_, -0.25f, 40);
+    const AnyOctree scaled = AnyOctree::open(path_);
+    const Histogram d = value_histogram(scaled, 128, uint64_t(1) << 30), t = value_histogram(scaled, 128, 0);
+    EXPECT_EQ(t.lo, d.lo);
+    EXPECT_EQ(t.hi, d.hi);
+    ASSERT_EQ(t.counts.size(), 128u);
+    uint64_t total = 0;
+    for (const uint64_t c : t.counts) total += c;
+    EXPECT_EQ(total, kDims.voxels());
+    EXPECT_GT(t.counts.front(), 0u);   // the corners' small real values
+    EXPECT_GT(t.counts.back(), 0u);    // the centre's largest
+}
+
 TEST_F(ViewSessionScale, FrameAtARealIsovalueIsTheStoredIsovaluesImageAndTheCommandReproducesIt) {
     const std::string tools = OCTISO_TOOLS_DIR;
     if (!std::filesystem::exists(tools + "/octiso-render")) {
