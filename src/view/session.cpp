@@ -11,6 +11,7 @@
 
 #include "octiso/error.h"
 #include "octiso/look.h"
+#include "octiso/oct_file.h"
 #include "octiso/render.h"
 #include "octiso/shading.h"
 #include "octiso/value_stats.h"
@@ -96,7 +97,11 @@ Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_by
         // tree (value_stats.h: a scalar leaf counts once for all its voxels, caps voxel by voxel),
         // in stored-value bins over the voxels' exact range, turned into real values. The
         // scale is affine, so bins of equal stored width are bins of equal real width; a
-        // negative slope reverses their order.
+        // negative slope reverses their order. value_stats reads the step three times: past
+        // kTreeHistogramFileBytes (a file the page cache may not hold: the 21 GiB step of the
+        // larger-than-RAM run would take minutes) the page goes without one.
+        constexpr uint64_t kTreeHistogramFileBytes = uint64_t(4) << 30;
+        if (step.file() && step.file()->file_bytes() > kTreeHistogramFileBytes) return h;
         const ValueStats stats = value_stats(step, bins);
         const std::array<double, 2> real = scale.real_range(stats.range);
         h.lo = real[0], h.hi = real[1];

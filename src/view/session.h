@@ -89,7 +89,8 @@ private:
 
 /// Step 0's values as real values (its value_scale applied) in `bins` bins over its real value
 /// range, from the decoded array when it is at most `max_dense_bytes`; else from the tree
-/// (value_stats: the cost of the stored size) over the voxels' exact real range.
+/// (value_stats: three reads of the stored step) over the voxels' exact real range, for files
+/// up to 4 GiB (above, counts is empty: the page draws no histogram).
 Histogram value_histogram(const AnyOctree& step, int bins, uint64_t max_dense_bytes);
 
 /// The octiso-render command line for `camera`, the real isovalue `iso`, `look` (shadows and
