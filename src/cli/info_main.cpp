@@ -64,10 +64,8 @@ struct Extract {
     uint64_t bytes = 0;
 };
 
-/// Decodes step `ex.step` and writes it x-fastest through AtomicOutput, byte-swapped if asked.
-/// Raw output goes out in slabs of layers (kExtractSlabBytes), so a step larger than memory
-/// extracts too (issue 13: a volume larger than RAM comes back byte for byte); formats with a
-/// header are written by VTK from one dense array and keep the memory check.
+/// Raw output goes out in slabs of layers of at most this many bytes, so a step larger than
+/// memory extracts too (issue 13: the 27 GiB volume comes back byte for byte).
 constexpr uint64_t kExtractSlabBytes = uint64_t(256) << 20;
 
 /// kExtractSlabBytes, or OCTISO_EXTRACT_SLAB_BYTES where set (tests: slabs of a few layers, so
@@ -80,18 +78,22 @@ uint64_t extract_slab_bytes() {
     return end && *end == '\0' && v > 0 ? uint64_t(v) : kExtractSlabBytes;
 }
 
+/// Decodes step `ex.step` and writes it x-fastest through AtomicOutput, byte-swapped if asked:
+/// raw in slabs (kExtractSlabBytes); the formats with a header through VTK's writers, from one
+/// dense array.
 void extract_raw(const std::shared_ptr<const OctFile>& file, Extract& ex) {
     const OctInfo& info = file->info();
     ex.bytes = checked_volume_bytes(info.dims, info.type, file->path());
+    // A dense array is decoded in memory: refuse up front, naming the size, rather than fail on
+    // allocation (a sparse 16384^3 octree is 98 KB on disk and 16 TiB as an array), and before
+    // the step is validated (that reads the whole file).
+    const uint64_t memory = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
+    if (ex.with_header && ex.bytes > memory)
+        throw Error("--extract", "step " + std::to_string(ex.step) + " of " + file->path() + " is " + std::to_string(ex.bytes) +
+                                     " bytes as a dense array, more than this machine's " + std::to_string(memory) +
+                                     " bytes of memory (--extract-raw writes it slab by slab)");
     const AnyOctree step = AnyOctree::step(file, ex.step);
     if (ex.with_header) {   // the formats' own byte order declaration: native
-        // The dense array is decoded in memory: refuse up front, naming the size, rather than
-        // fail on allocation (a sparse 16384^3 octree is 98 KB on disk and 16 TiB as an array).
-        const uint64_t memory = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
-        if (ex.bytes > memory)
-            throw Error("--extract", "step " + std::to_string(ex.step) + " of " + file->path() + " is " +
-                                         std::to_string(ex.bytes) + " bytes as a dense array, more than this machine's " +
-                                         std::to_string(memory) + " bytes of memory (--extract-raw writes it slab by slab)");
         std::vector<std::byte> data(size_t(ex.bytes));
         step.decode(data, std::endian::native);
         file->check_unchanged();

@@ -236,13 +236,10 @@ std::optional<std::string> text_stream_refusal(const std::string& path, VolumeFo
     return plan.layout ? std::nullopt : std::optional<std::string>(std::move(plan.why_not));
 }
 
-std::unique_ptr<VolumeStream> open_text_stream(const std::string& path, VolumeFormat format) {
-    const TextStreamPlan plan = plan_text_stream(path, format);
-    if (!plan.layout)
-        throw Error(path, std::string(volume_format_name(format)) + " input is read whole, not streamed (" + plan.why_not + ")",
-                    ErrorKind::Other);
+namespace {
+
+std::unique_ptr<VolumeStream> open_planned(const std::string& path, const TextStreamPlan& plan, VolumeFormat format) {
     const io::DataLayout& layout = *plan.layout;
-    const Placement& placement = plan.placement;
     const int fd = ::open(layout.data_path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) throw Error(layout.data_path, std::string("cannot open: ") + std::strerror(errno));
     try {
@@ -251,7 +248,22 @@ std::unique_ptr<VolumeStream> open_text_stream(const std::string& path, VolumeFo
         ::close(fd);
         throw;
     }
-    return std::make_unique<TextStream>(path, layout, placement, format, fd);
+    return std::make_unique<TextStream>(path, layout, plan.placement, format, fd);
+}
+
+}  // namespace
+
+std::unique_ptr<VolumeStream> open_text_stream(const std::string& path, VolumeFormat format) {
+    const TextStreamPlan plan = plan_text_stream(path, format);
+    if (!plan.layout)
+        throw Error(path, std::string(volume_format_name(format)) + " input is read whole, not streamed (" + plan.why_not + ")",
+                    ErrorKind::Other);
+    return open_planned(path, plan, format);
+}
+
+std::unique_ptr<VolumeStream> try_open_text_stream(const std::string& path, VolumeFormat format) {
+    const TextStreamPlan plan = plan_text_stream(path, format);
+    return plan.layout ? open_planned(path, plan, format) : nullptr;
 }
 
 }  // namespace octiso

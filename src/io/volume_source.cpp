@@ -147,7 +147,7 @@ LoadedVolume read_stream_whole(VolumeStream& s) {
     } catch (const std::bad_alloc&) {
         throw Error(s.source(), "out of memory reading the " + std::to_string(s.bytes()) + " voxel bytes the header declares");
     }
-    s.read_layers(s.dims().z - s.next_layer(), buffer->data() + s.next_layer() * s.layer_bytes());
+    s.read_layers(s.dims().z, buffer->data());
     const std::byte* data = buffer->data();
     LoadedVolume v(std::move(buffer), data, s.type(), s.dims(), s.placement(), false, s.source(), s.format());
     v.set_source_order(s.value_scale(), s.flipped_axes());
@@ -164,13 +164,14 @@ LoadedVolume open_volume(const std::string& path, const RawOptions& options) {
     // NRRD reader leaves big-endian gzip data unswapped and reads ascii data as zeros
     // (text_stream_test.cpp shows both); VTK still gives the placement. The layouts the stream
     // leaves alone are VTK's.
-    const bool text = (format == VolumeFormat::nrrd || format == VolumeFormat::meta_image) && !options.array &&
-                      !text_stream_refusal(path, format);
+    std::unique_ptr<VolumeStream> text;
+    if ((format == VolumeFormat::nrrd || format == VolumeFormat::meta_image) && !options.array)
+        text = try_open_text_stream(path, format);
     LoadedVolume volume = format == VolumeFormat::raw
                               ? read_raw(path, *options.dims, *options.type, options.endian.value_or(Endian::little),
                                          options.offset.value_or(0))
                           : format == VolumeFormat::nifti ? read_nifti(path)
-                          : text                          ? read_stream_whole(*open_text_stream(path, format))
+                          : text                          ? read_stream_whole(*text)
                                                           : read_vtk(path, format, options.array);
     volume.set_placement(overridden_placement(volume.placement(), volume.dims(), path, options));
     return volume;

@@ -105,6 +105,9 @@ std::unique_ptr<VolumeStream> open_nifti_stream(const std::string& path);
 /// swapped when big-endian, placed as VTK places it. Throws Error(path, ...) when
 /// text_stream_refusal() gives a reason.
 std::unique_ptr<VolumeStream> open_text_stream(const std::string& path, VolumeFormat format);
+/// open_text_stream(), or null where text_stream_refusal() would give a reason (the header is
+/// planned once, for open_volume()'s choice between the stream and VTK).
+std::unique_ptr<VolumeStream> try_open_text_stream(const std::string& path, VolumeFormat format);
 /// Why a NRRD or MetaImage file cannot be streamed (its layout is one the stream does not read,
 /// or VTK reads its grid or type differently from the header's plain meaning); nullopt if it can.
 std::optional<std::string> text_stream_refusal(const std::string& path, VolumeFormat format);
@@ -118,10 +121,10 @@ void pread_fully(int fd, std::byte* dst, uint64_t bytes, uint64_t pos, const std
 /// a 4-D file (convert() makes those a series through the stream).
 LoadedVolume read_nifti(const std::string& path);
 
-/// Every layer of the stream's current volume read into memory, as a LoadedVolume with the
-/// stream's placement, value scale, flips and warning: the in-memory converter's reader for the
-/// formats it streams, so that both paths read them with the same code. Error(source, ...) when
-/// the voxels do not fit in memory.
+/// Every layer of the stream's current volume (nothing read from it yet) into memory, as a
+/// LoadedVolume with the stream's placement, value scale, flips and warning: the in-memory
+/// converter's reader for the formats it streams, so that both paths read them with the same
+/// code. Error(source, ...) when the voxels do not fit in memory.
 LoadedVolume read_stream_whole(VolumeStream& stream);
 
 /// Whether open_volume_stream() can stream `path` (raw, NIfTI, and NRRD or MetaImage that
