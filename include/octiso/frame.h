@@ -10,6 +10,11 @@ namespace octiso {
 
 struct RenderStats {
     double seconds = 0;                 ///< wall time of the tile loop
+    /// Thread seconds spent inside tiles, summed over the tiles (issue 12). busy_seconds /
+    /// (threads x seconds) is the loop's utilisation: what it lacks is waiting (start-up, the
+    /// last tiles, stealing); a busy time that grows with the thread count at the same rays is
+    /// each ray costing more (shared caches, memory bandwidth), not scheduling.
+    double busy_seconds = 0;
     uint64_t rays = 0, hits = 0;
     int threads = 0;
     /// Hits by the side of the cell they lie in: hits_by_cell_log2[k] counts cells of 2^k voxels

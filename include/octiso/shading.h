@@ -32,6 +32,9 @@ struct Shading {
     /// --clip-cap: the caps cap_clip_planes drew into the frame; a hit on one shows the innermost
     /// isovalue whose inside holds it, not the isovalue nearest to the field there.
     std::optional<ClipCap> cap;
+    /// Threads of the pass (rows in parallel; 0: all cores), as RenderOptions::threads. The pixels
+    /// are independent, so the frame is the same bit for bit on any count.
+    int threads = 0;
 };
 
 /// Fills frame.rgb (8-bit sRGB, resized to the frame) from frame.depth and frame.normal, both

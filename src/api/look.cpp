@@ -26,6 +26,7 @@
 #include "render/shade.h"
 #include "render/tile_loop.h"
 #include "render/tracer_kernel.h"
+#include "util/shared_arena.h"
 
 namespace octiso {
 
@@ -57,7 +58,6 @@ struct LookShader::Impl {
     Look look;
     TracerKernel kernel;
     double voxel = 1;
-    std::unique_ptr<tbb::task_arena> arena;   ///< only when options.threads > 0, as the Renderer's
     std::mutex lod_mutex;                     ///< held while a frame with level of detail is shaded (the cut is the camera's)
 };
 
@@ -71,7 +71,6 @@ LookShader::LookShader(const AnyOctree& tree, const RenderOptions& options, cons
     });
     const auto& s = tree.placement().spacing;
     impl_->voxel = std::min({std::fabs(s[0]), std::fabs(s[1]), std::fabs(s[2])});
-    if (options.threads > 0) impl_->arena = std::make_unique<tbb::task_arena>(options.threads);
 }
 
 LookShader::~LookShader() = default;
@@ -243,8 +242,7 @@ LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame&
             return 0;
         });
     };
-    if (m.arena) m.arena->execute(run);
-    else run();
+    in_shared_arena(m.options.threads, run);   // the Renderer's arena: its workers are there (util/shared_arena.h)
     LookStats stats;
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     stats.shadow_rays = shadow_rays, stats.ao_rays = ao_rays, stats.layer_rays = layer_rays;

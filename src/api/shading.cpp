@@ -5,12 +5,16 @@
 #include <charconv>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "math/vec.h"
 #include "octiso/error.h"
 #include "api/hit_colour.h"
 #include "render/light_kit.h"
 #include "render/pinhole_camera.h"
 #include "render/shade.h"
+#include "util/shared_arena.h"
 
 namespace octiso {
 
@@ -37,7 +41,11 @@ void shade_frame(const AnyOctree& tree, const std::vector<double>& isovalues, co
     dispatch_scalar_type(tree.type(), [&](auto zero) {
         using T = decltype(zero);
         const Octree<T>& octree = *tree.as<T>();
-        for (int py = 0; py < frame.height; ++py)
+        // Rows in parallel (issue 12), in the Renderer's arena: on one thread after a parallel
+        // trace this pass was 22 ms of a 1024^2 ch2better frame (BENCHMARKS.md "Many-core"),
+        // as long as the whole trace would be on 16 threads.
+        const auto shade_rows = [&](const tbb::blocked_range<int>& rows) {
+        for (int py = rows.begin(); py < rows.end(); ++py)
             for (int px = 0; px < frame.width; ++px) {
                 const size_t i = size_t(py) * size_t(frame.width) + size_t(px);
                 const float t = frame.depth[i];
@@ -59,6 +67,8 @@ void shade_frame(const AnyOctree& tree, const std::vector<double>& isovalues, co
                 }
                 for (int a = 0; a < 3; ++a) out[a] = to_srgb8(float(rgb[size_t(a)]));
             }
+        };
+        in_shared_arena(shading.threads, [&] { tbb::parallel_for(tbb::blocked_range<int>(0, frame.height, 4), shade_rows); });
     });
 }
 

@@ -165,6 +165,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         throw Error("--lod", "level of detail is not available with --distribute data (each rank's cut would differ)");
     const int spp = spp_text ? int(cli::parse_int(*spp_text, "--spp", 1, kMaxSamplesPerPixel)) : 1;
     Shading shading;
+    shading.threads = options.threads;
     if (shading_text) {
         if (*shading_text == "kit") shading.model = ShadingModel::kit;
         else if (*shading_text == "headlight") shading.model = ShadingModel::headlight;
@@ -347,7 +348,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         const Job& job = jobs[n];
         // One Renderer per step, kept across the frames of an orbit; the Embree device behind it
         // is shared by the whole process.
+        double step_setup_seconds = 0;
         if (job.step != renderer_step) {
+            const auto setup_start = std::chrono::steady_clock::now();
             renderer.reset();
             step_tree.emplace(AnyOctree::step(file, uint32_t(job.step)));
             if (split_frames && distribute == Distribute::data)   // the voxels beyond the slab, from their owner
@@ -355,9 +358,11 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             renderer.emplace(step_tree->make_renderer(rank_options));
             if (deferred && look.active()) look_shader.emplace(*step_tree, rank_options, look, shading.model);
             renderer_step = job.step;
+            step_setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
         }
         FrameRecord record;
         record.index = job.index, record.step = job.step, record.rank = rank;
+        record.step_setup_seconds = step_setup_seconds;
         record.bytes_sent = std::exchange(ghost_bytes, 0);
         // One sample: traced by this rank (its tiles or its brick when frames are split), shaded
         // here (deferred shading reads only the pixel's own hit), then assembled on rank 0.
@@ -374,9 +379,11 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
                 stats = progress.trace(*renderer, c, f, n);   // in batches of tiles while a progress line is on
             }
             progress.shading();
+            const auto shade_start = std::chrono::steady_clock::now();
             if (shading.cap) cap_clip_planes(*step_tree, options.isovalues, *shading.cap, c, f);
             if (deferred && look_shader) record.look.add(look_shader->shade(c, shading, f));
             else if (deferred) shade_frame(*step_tree, options.isovalues, c, shading, f);
+            record.shade_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - shade_start).count();
             progress.sample_done();
             if (split_frames) {
                 const RankExchange cost = distribute == Distribute::image
@@ -389,6 +396,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             record.rays += stats.rays;
             for (size_t k = 0; k < stats.hits_by_cell_log2.size(); ++k) record.hits_by_cell_log2[k] += stats.hits_by_cell_log2[k];
             record.seconds += stats.seconds;
+            record.busy_seconds += stats.busy_seconds;
             record.threads = stats.threads;
             return stats;
         };
@@ -401,9 +409,11 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         if (!open_to_first_frame) open_to_first_frame = std::chrono::duration<double>(std::chrono::steady_clock::now() - open_start).count();
         file->check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
         if (root || !split_frames) {
+            const auto write_start = std::chrono::steady_clock::now();
             if (out_path) write_colour_image(name_for(out_path, "-o", job.index), frame);
             if (depth_path) write_depth_image(name_for(depth_path, "--depth", job.index), frame);
             if (normal_path) write_normal_image(name_for(normal_path, "--normal", job.index), frame);
+            record.write_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
             record.wrote = true;
         }
         // The effective camera, as flags that reproduce it (issue 17: a view can be pasted back);
@@ -469,6 +479,14 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             j.begin_object().field("step", r.step);
             if (orbit) j.field("frame", r.index);
             j.field("seconds", r.seconds).field("frame_seconds", r.frame_seconds);
+            // Issue 12: where the frame's time goes. trace is the tile loops (parallel; busy is its
+            // thread seconds, utilisation busy / (threads x trace)); shade the deferred passes;
+            // other the rest of the frame (buffers, antialiasing sums, the MPI exchange); write
+            // the image files; step_setup the Renderer of a new step (first frame of a step).
+            j.key("phases").begin_object().field("trace", r.seconds).field("trace_busy", r.busy_seconds)
+                .field("utilisation", r.seconds > 0 && r.threads > 0 ? r.busy_seconds / (r.seconds * r.threads) : 0.0)
+                .field("shade", r.shade_seconds).field("other", std::max(0.0, r.frame_seconds - r.seconds - r.shade_seconds))
+                .field("write", r.write_seconds).field("step_setup", r.step_setup_seconds).end_object();
             j.field("mrays_per_second", r.seconds > 0 ? double(r.rays) / r.seconds * 1e-6 : 0.0).field("rays", r.rays);
             j.field("hits", r.hits).field("threads", r.threads);
             if (options.lod > 0) {   // issue 14: hits by the depth whose cells they lie in (dmax: full resolution)

@@ -22,7 +22,7 @@ RenderStats render_in_batches(const Renderer& renderer, const Camera& camera, Fr
     while (done < count) {
         const int n = std::min(batch, count - done);
         const RenderStats s = renderer.render_tiles(camera, std::span<const int>(tiles).subspan(size_t(done), size_t(n)), frame);
-        total.seconds += s.seconds, total.rays += s.rays, total.hits += s.hits;
+        total.seconds += s.seconds, total.busy_seconds += s.busy_seconds, total.rays += s.rays, total.hits += s.hits;
         for (size_t k = 0; k < s.hits_by_cell_log2.size(); ++k) total.hits_by_cell_log2[k] += s.hits_by_cell_log2[k];
         total.threads = std::max(total.threads, s.threads);
         done += n;

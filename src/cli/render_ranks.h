@@ -31,6 +31,10 @@ struct FrameRecord {
     long long index = 0, step = 0;
     int rank = 0;
     double seconds = 0, frame_seconds = 0, exchange_seconds = 0, rank_wall_seconds = 0;
+    /// Per-frame phases (issue 12: the serial parts visible in --json): thread seconds inside
+    /// tiles (RenderStats::busy_seconds), the deferred shading and clip-cap passes, the image
+    /// writes, and the step's Renderer set-up (on the first frame of a step only).
+    double busy_seconds = 0, shade_seconds = 0, write_seconds = 0, step_setup_seconds = 0;
     uint64_t rays = 0, hits = 0, bytes_sent = 0;
     std::array<uint64_t, 32> hits_by_cell_log2{};   ///< RenderStats::hits_by_cell_log2, summed over samples
     uint64_t file_resident_bytes = 0;   ///< of the rank's mapping of the .oct after its frames (smaps)

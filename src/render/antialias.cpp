@@ -59,6 +59,7 @@ RenderStats render_antialiased(const SampleRenderer& render_sample, const Camera
         shifted.pixel_offset = subpixel_offset(s);
         const RenderStats more = render_sample(shifted, sample);
         stats.seconds += more.seconds;
+        stats.busy_seconds += more.busy_seconds;
         stats.rays += more.rays;
         if (shade) shade(shifted, sample);
         for (size_t i = 0; i < sum.size(); ++i) sum[i] += to_linear.table[sample.rgb[i]];

@@ -19,6 +19,7 @@
 #include "render/pinhole_camera.h"
 #include "render/shade.h"
 #include "render/tile_loop.h"
+#include "util/shared_arena.h"
 #include "render/tracer_kernel.h"
 #include "scene/embree_scene.h"
 
@@ -58,18 +59,14 @@ struct Renderer::Impl {
     virtual ScalarType type() const = 0;
     RenderOptions options;
     RenderLimits limits;
-    std::unique_ptr<tbb::task_arena> arena;   ///< only when options.threads > 0
     std::shared_ptr<const void> storage;      ///< keep_alive(): the octree's arrays, if shared
 
     void adopt(const RenderOptions& o) {
         validate_options(o, limits);
-        if (o.threads != options.threads || (o.threads > 0 && !arena)) {
-            arena.reset();
-            if (o.threads > 0) arena = std::make_unique<tbb::task_arena>(o.threads);
-        }
         options = o;
     }
-    template <class F> decltype(auto) in_arena(F&& f) const { return arena ? arena->execute(f) : f(); }
+    /// The process's arena of options.threads (util/shared_arena.h), shared with the frame's other passes.
+    template <class F> decltype(auto) in_arena(F&& f) const { return in_shared_arena(options.threads, f); }
 };
 
 namespace {

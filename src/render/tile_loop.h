@@ -2,6 +2,8 @@
 // its tiles are handed to TBB one by one (simple partitioner, work stealing). The caller's
 // task_arena decides the thread count. Per tile, `body(rect, stats)` traces the pixels of `rect`
 // into plain local counters, folded into the shared ones once per tile (no shared atomics per ray).
+// Each tile's own wall time is summed too (two clock reads per tile, ~40 ns against the 0.1-1 ms a
+// 16x16 tile takes), so the loop's utilisation is measured on every frame (issue 12).
 #pragma once
 
 #include <atomic>
@@ -27,7 +29,7 @@ struct TileCounters {
 /// Runs body(const PixelRect&, TileCounters&) for the tiles `tiles` of `grid` (all tiles when
 /// `all`), in parallel; returns the wall time and the summed counters.
 template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<const int> tiles, bool all, Body&& body) {
-    std::atomic<uint64_t> rays{0}, hits{0};
+    std::atomic<uint64_t> rays{0}, hits{0}, busy_ns{0};
     std::array<std::atomic<uint64_t>, 32> by_cell{};
     const int n = all ? grid.count() : int(tiles.size());
     const auto t0 = std::chrono::steady_clock::now();
@@ -38,7 +40,9 @@ template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<
                 TileCounters local;
                 const int tile = all ? i : tiles[size_t(i)];
                 OCTISO_DCHECK(tile >= 0 && tile < grid.count(), "tile ", tile, " of ", grid.count());
+                const auto started = std::chrono::steady_clock::now();
                 body(grid.rect(tile), local);
+                busy_ns += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - started).count());
                 rays += local.rays;
                 hits += local.hits;
                 for (size_t k = 0; k < by_cell.size(); ++k)
@@ -48,6 +52,7 @@ template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<
         tbb::simple_partitioner());
     RenderStats stats;
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stats.busy_seconds = double(busy_ns.load()) * 1e-9;
     stats.rays = rays;
     stats.hits = hits;
     for (size_t k = 0; k < by_cell.size(); ++k) stats.hits_by_cell_log2[k] = by_cell[k];

@@ -94,6 +94,23 @@ TEST(Shading, TheLightKitSpreadsTheForegroundWiderThanTheHeadlight) {
     EXPECT_GT(luminance_spread(r.aovs), 1.2 * luminance_spread(r.own));
 }
 
+TEST(Shading, RowsInParallelGiveTheSameFrameOnAnyThreadCount) {
+    // Issue 12: the pass runs rows in parallel; each pixel reads only its own AOVs.
+    const AnyOctree tree = AnyOctree::build(synthetic_step("marschner-lobb", {33, 33, 33}, 0, ScalarType::f32), {});
+    const std::vector<double> isos{0.2, 0.5, 0.8};
+    Rendered r = render_both(tree, isos);
+    Frame serial = r.aovs;
+    Shading s;
+    s.threads = 1;
+    shade_frame(tree, isos, r.camera, s, serial);
+    for (int threads : {0, 2, 3}) {
+        Frame f = r.aovs;
+        s.threads = threads;
+        shade_frame(tree, isos, r.camera, s, f);
+        EXPECT_EQ(f.rgb, serial.rgb) << threads << " threads";
+    }
+}
+
 TEST(Shading, MissingAovsAreAnError) {
     const AnyOctree tree = AnyOctree::build(synthetic_step("sphere", {8, 8, 8}, 0), {});
     Rendered r = render_both(tree, {3});

@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "format/oct_test_util.h"
 #include "test_util/run_shell.h"
 #include "octiso/image.h"
@@ -61,6 +63,20 @@ TEST_F(RenderCli, WritesColourDepthAndNormalImagesAndOneJsonObject) {
     EXPECT_NE(json.find("\"seconds\""), std::string::npos);
     EXPECT_NE(json.find("\"mrays_per_second\""), std::string::npos);
     EXPECT_NE(json.find("\"hits\""), std::string::npos);
+    // Issue 12: each frame says where its time went, and the phases add up to the frame.
+    const nlohmann::json report = nlohmann::json::parse(json);
+    const nlohmann::json& frame = report.at("frames").at(0);
+    const nlohmann::json& phases = frame.at("phases");
+    EXPECT_EQ(phases.at("trace").get<double>(), frame.at("seconds").get<double>());
+    for (const char* key : {"trace", "trace_busy", "shade", "other", "write", "step_setup"})
+        EXPECT_GE(phases.at(key).get<double>(), 0.0) << key;
+    EXPECT_GT(phases.at("trace_busy").get<double>(), 0.0);
+    EXPECT_GT(phases.at("write").get<double>(), 0.0) << "three images were written";
+    EXPECT_GT(phases.at("step_setup").get<double>(), 0.0) << "the first frame of step 0 made its Renderer";
+    EXPECT_GT(phases.at("utilisation").get<double>(), 0.0);
+    EXPECT_LE(phases.at("utilisation").get<double>(), 1.0 + 1e-6);
+    EXPECT_LE(phases.at("trace").get<double>() + phases.at("shade").get<double>() + phases.at("other").get<double>(),
+              frame.at("frame_seconds").get<double>() + 1e-9);
 
     const FloatImage c = read_image(out.file("c.png"));
     EXPECT_EQ(c.width, 40);

@@ -111,6 +111,21 @@ TEST_F(RendererTest, ReusedFrameBuffersCarryNothingOver) {
     expect_identical(reused, renderer.render(aside));
 }
 
+TEST_F(RendererTest, BusyTimeIsTheTilesOwnAndFitsInsideTheLoop) {
+    // Issue 12: busy_seconds sums each tile's own wall time. The tiles of one loop run inside its
+    // interval, at most `threads` at once, so the sum cannot exceed threads x the loop's wall time;
+    // a frame traces something, so it is positive. (A structural bound, not a speed.)
+    for (int threads : {1, 2}) {
+        RenderOptions o = options_;
+        o.threads = threads;
+        const Renderer renderer(data_.view(), Placement{}, o);
+        const RenderStats stats = renderer.render(camera_).stats;
+        EXPECT_EQ(stats.threads, threads);
+        EXPECT_GT(stats.busy_seconds, 0.0);
+        EXPECT_LE(stats.busy_seconds, double(stats.threads) * stats.seconds + 1e-6) << threads << " threads";
+    }
+}
+
 TEST_F(RendererTest, BadCallsAreRefused) {
     const Renderer renderer(data_.view(), Placement{}, options_);
     Frame frame;
