@@ -215,6 +215,12 @@ void write_json(std::ostream& os, const ConvertReport& r, const std::optional<st
     j.end_array();
     j.key("warnings").array(r.warnings);
     j.field("build_seconds", r.build_seconds).field("total_seconds", r.total_seconds);
+    if (!r.streamed && !r.built_directly) {   // issue 12: which parts of the conversion are serial
+        const BuildPhases& p = r.build_phases;
+        j.key("phases").begin_object().field("read", r.read_seconds).field("prepare", p.prepare).field("pieces", p.pieces)
+            .field("top", p.top).field("concatenate", p.concatenate).field("release", p.release)
+            .field("write", r.write_seconds).end_object();
+    }
     j.field("mvoxels_per_second", r.mvoxels_per_second());
     j.field("peak_rss_bytes", r.peak_rss_bytes).field("threads", r.threads);
     j.field("streamed", r.streamed).field("memory_budget", r.memory_budget).field("piece_side", r.piece_side);

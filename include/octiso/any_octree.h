@@ -49,6 +49,7 @@ struct AnyOctreeInfo {
     ValueScale value_scale;
     uint8_t flipped_axes = 0;                          ///< source axes reversed at conversion
     uint64_t dense_bytes = 0;                          ///< dims x scalar size: what decode() writes
+    std::optional<BuildPhases> build_phases;           ///< a tree built in memory: its build's phases (build.h)
     std::string source;                                ///< the file or input it came from
 };
 

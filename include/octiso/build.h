@@ -30,6 +30,14 @@ struct BuildOptions {
     uint8_t flipped_axes = 0;
 };
 
+/// Wall seconds of the in-memory build's phases (issue 12: what does not scale is visible in
+/// octiso-convert --json on any machine). pieces is the parallel bulk; prepare is parallel too;
+/// top is serial and small; concatenate copies the pieces' arrays into the final ones (parallel
+/// over pieces in batches) and release is the malloc_trim between batches (serial).
+struct BuildPhases {
+    double prepare = 0, pieces = 0, top = 0, concatenate = 0, release = 0;
+};
+
 /// Counts per depth d = 0 .. dmax-1: stored nodes (interior; caps at dmax-1) and scalar leaves
 /// (children of depth-d nodes that are leaves, data-covering or padding).
 struct BuildStats {
@@ -39,6 +47,7 @@ struct BuildStats {
     uint64_t minmax_bytes = 0;     ///< the part of interior_bytes that is child bounds
     uint64_t cap_bytes = 0;        ///< packed cap records
     double seconds = 0;
+    BuildPhases phases;
 };
 
 /// A fixed-size array whose elements start uninitialised, so that its pages become resident only

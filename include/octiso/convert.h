@@ -119,6 +119,11 @@ struct ConvertReport {
     uint32_t piece_side = 0;     ///< the out-of-core pieces' side, when streamed
     uint64_t bytes_read = 0;     ///< from the input files, when streamed
     uint64_t spilled_bytes = 0;  ///< node bytes that went through temporary files, when streamed
+    /// In-memory conversion (issue 12): seconds of reading (or generating) the steps, of each
+    /// build phase summed over the steps (build.h), and of appending the built steps to the file.
+    /// Zero when streamed, whose slabs are read and built interleaved (build_seconds).
+    double read_seconds = 0, write_seconds = 0;
+    BuildPhases build_phases;
 
     double ratio() const { return input_bytes ? double(file_bytes) / double(input_bytes) : 0.0; }
     double mvoxels_per_second() const {

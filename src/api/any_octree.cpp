@@ -23,6 +23,7 @@ struct AnyOctree::Impl {
     virtual Dims dims() const = 0;
     virtual int dmax() const = 0;
     virtual StepSizes sizes() const = 0;
+    virtual std::optional<BuildPhases> build_phases() const = 0;
     virtual std::optional<std::array<double, 2>> value_range() const = 0;
     virtual void append_to(OctWriter& writer) const = 0;
     virtual Renderer make_renderer(const RenderOptions& options, const RenderLimits& limits) const = 0;
@@ -60,6 +61,9 @@ public:
     ScalarType type() const override { return scalar_type_of<T>(); }
     Dims dims() const override { return tree_.dims(); }
     int dmax() const override { return tree_.dmax(); }
+    std::optional<BuildPhases> build_phases() const override {
+        return data_ ? std::optional<BuildPhases>(data_->stats.phases) : std::nullopt;
+    }
     StepSizes sizes() const override { return data_ ? sizes_ : file->step_sizes(step_); }
 
     std::optional<std::array<double, 2>> value_range() const override {
@@ -187,6 +191,7 @@ AnyOctreeInfo AnyOctree::info() const {
     i.value_scale = header.value_scale;
     i.flipped_axes = header.flipped_axes;
     i.sizes = impl_->sizes();
+    i.build_phases = impl_->build_phases();
     i.value_range = impl_->value_range();
     i.dense_bytes = dense_bytes();
     i.source = impl_->source;

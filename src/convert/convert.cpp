@@ -273,22 +273,34 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
     //    finish(), and each step's volume and octree are dropped before the next is opened.
     ConvertReport r;
     OctWriter writer(output, info);
+    r.read_seconds = seconds_since(t_start);   // step 0 (and the others' checks) read above
     for (uint32_t i = 0; i < n_steps; ++i) {
+        const Clock::time_point t_read = Clock::now();
         LoadedVolume v = i == 0 ? std::move(*step0) : source.load(i);
+        if (i > 0) r.read_seconds += seconds_since(t_read);
         step0.reset();
         if (i > 0) check_same_grid(first, v);   // a file may have changed since step 1
         opt.source_name = v.source();
         const Clock::time_point t0 = Clock::now();
         const AnyOctree tree = AnyOctree::build(v, opt);
         const double build_seconds = seconds_since(t0);
-        ConvertStepReport step{v.source(), tree.info().sizes, build_seconds};
+        const AnyOctreeInfo built = tree.info();
+        ConvertStepReport step{v.source(), built.sizes, build_seconds};
         r.build_seconds += step.build_seconds;
+        if (const auto& p = built.build_phases) {
+            r.build_phases.prepare += p->prepare, r.build_phases.pieces += p->pieces, r.build_phases.top += p->top;
+            r.build_phases.concatenate += p->concatenate, r.build_phases.release += p->release;
+        }
         add_sizes(r.total, step.sizes);
+        const Clock::time_point t_write = Clock::now();
         tree.append_to(writer);
+        r.write_seconds += seconds_since(t_write);
         r.per_step.push_back(std::move(step));
         if (memory.on_progress) memory.on_progress(first.bytes * (i + 1), first.bytes * n_steps, first.dims.voxels() * (i + 1));
     }
+    const Clock::time_point t_finish = Clock::now();
     writer.finish();
+    r.write_seconds += seconds_since(t_finish);
 
     // 3. Measure.
     fill_report(r, source, output, first, info.dmax, n_steps, options, writer);

@@ -33,6 +33,7 @@
 #include "octree/piece_builder.h"
 #include "octree/summary.h"
 #include "util/check.h"
+#include "util/shared_arena.h"
 
 namespace octiso {
 
@@ -74,6 +75,8 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
     if (input.dims.x == 0 || input.dims.y == 0 || input.dims.z == 0)
         throw Error(options.source_name, "volume has a zero dimension");
     detail::PreparedVolume<T> prepared = detail::prepare_volume(input, options);
+    BuildPhases phases;
+    phases.prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     OctreeData<T> out;
     out.dims = input.dims;
@@ -91,11 +94,18 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
     };
     enumerate(enumerate, 0, Coord{});
 
+    auto t_phase = std::chrono::steady_clock::now();
+    const auto phase_done = [&](double& phase) {
+        const auto now = std::chrono::steady_clock::now();
+        phase = std::chrono::duration<double>(now - t_phase).count();
+        t_phase = now;
+    };
     std::vector<Sink<T>> sinks;
     sinks.reserve(origins.size());
     for (size_t i = 0; i < origins.size(); ++i) sinks.emplace_back(dmax);
     std::vector<Summary<T>> roots(origins.size());
     tbb::parallel_for(size_t(0), origins.size(), [&](size_t i) { roots[i] = builder.build(k, origins[i], sinks[i]); });
+    phase_done(phases.pieces);
 
     // 2. The top: the same descent, taking each depth-k summary from its piece. A depth-(k-1)
     //    node's child_start counts the piece roots stored before it.
@@ -118,11 +128,42 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
     // The top must consume every piece in the order they were cut, or child_start at depth k-1
     // would point at another piece's root.
     OCTISO_CHECK(k == 0 || next_piece == origins.size(), next_piece, " of ", origins.size(), " pieces consumed");
+    phase_done(phases.top);
 
-    // 3. Concatenate depth by depth. Depths below k come from `top` alone. Freed piece memory is
-    //    handed back every few pieces, so peak memory stays near input + output.
-    constexpr uint64_t kPiecesPerRelease = 16;
-    uint64_t moved = 0;
+    // 3. Concatenate depth by depth. Depths below k come from `top` alone. The pieces of a depth
+    //    are copied in parallel, in batches of 16 pieces or two per thread (whichever is more):
+    //    each piece's place and child offset are prefix sums, so the copies are independent
+    //    (issue 12: serial, the copy and the trims were about 0.04 s of a 1.2 s 1-thread build of
+    //    plume 512^3, an Amdahl bound of 67 % at 16 threads; BENCHMARKS.md "Many-core"). Freed piece
+    //    memory is handed back as the copy goes, so peak memory stays near input + output.
+    const auto t_concat = std::chrono::steady_clock::now();
+    double release_seconds = 0;
+    const auto release = [&] {
+        const auto t = std::chrono::steady_clock::now();
+        release_free_memory();
+        release_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+    };
+    const size_t batch = std::max<size_t>(16, 2 * size_t(tbb::this_task_arena::max_concurrency()));
+    uint64_t tree_bytes = 0;
+    for (const auto& sk : sinks) {
+        tree_bytes += sk.caps.size();
+        for (const auto& v : sk.nodes) tree_bytes += v.size() * sizeof(InteriorNode<T>);
+    }
+    // Freed memory is handed back once a 64th of the tree (at least 1 MiB) was freed since the last
+    // time, not after every batch: malloc_trim walks every arena each call. Plume 512^3, 1 and 2
+    // threads, 2 interleaved rounds (octiso-convert --json phases): release 13-15 / 21-24 ms after
+    // every batch against 7-9 / 11 ms, peak RSS 191.1-191.6 against 191.9-192.2 MiB (+0.3 %).
+    const uint64_t release_every = std::max<uint64_t>(uint64_t(1) << 20, tree_bytes / 64);
+    uint64_t pending = 0;
+    // Runs copy(i) for every part index i in parallel, one batch at a time, releasing between.
+    const auto in_batches = [&](size_t count, auto&& bytes_of, auto&& copy) {
+        for (size_t b = 0; b < count; b += batch) {
+            const size_t e = std::min(count, b + batch);
+            for (size_t i = b; i < e; ++i) pending += bytes_of(i);
+            tbb::parallel_for(b, e, [&](size_t i) { copy(i); });
+            if (pending >= release_every) release(), pending = 0;
+        }
+    };
     out.nodes.resize(size_t(dmax - 1));
     out.stats.nodes_per_depth.assign(size_t(dmax), 0);
     out.stats.scalar_leaves_per_depth.assign(size_t(dmax), 0);
@@ -130,23 +171,32 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
         std::vector<Sink<T>*> parts;
         if (d < k) parts.push_back(&top);
         else for (auto& s : sinks) parts.push_back(&s);
-        uint64_t total = 0;
-        for (auto* p : parts) total += p->nodes[size_t(d)].size();
-        // Children at depth d+1, as they will be concatenated (before this depth's moves free them).
-        uint64_t next_total = 0;
+        // Where each part's nodes go, and how many children the parts before it contributed at
+        // depth d+1 (read before this depth's moves free the depth-d arrays; depth d+1 is intact).
         const bool caps_below = d + 1 == dmax - 1;
+        std::vector<uint64_t> at(parts.size()), child_offset(parts.size());
+        uint64_t total = 0, children = 0;
+        for (size_t i = 0; i < parts.size(); ++i) {
+            at[i] = total;
+            child_offset[i] = d >= k ? children : 0;
+            total += parts[i]->nodes[size_t(d)].size();
+            children += caps_below ? parts[i]->caps.size() : parts[i]->nodes[size_t(d + 1)].size();
+            out.stats.scalar_leaves_per_depth[size_t(d)] += parts[i]->leaves[size_t(d)];
+        }
+        // Children at depth d+1, as they will be concatenated.
+        uint64_t next_total = 0;
         if (caps_below) for (auto& s : sinks) next_total += s.caps.size();
         else if (d + 1 < k) next_total = top.nodes[size_t(d + 1)].size();
         else for (auto& s : sinks) next_total += s.nodes[size_t(d + 1)].size();
         // Interior children are 32-bit node indices, caps 48-bit byte offsets (octree.h).
         const uint64_t limit = caps_below ? kMaxCapByteOffset : uint64_t(1) << 32;
         out.nodes[size_t(d)] = UninitArray<InteriorNode<T>>::make(total);
-        uint64_t at = 0, child_offset = 0;
-        for (auto* p : parts) {
-            auto& v = p->nodes[size_t(d)];
+        in_batches(parts.size(), [&](size_t i) { return parts[i]->nodes[size_t(d)].size() * sizeof(InteriorNode<T>); },
+                   [&](size_t i) {
+            auto& v = parts[i]->nodes[size_t(d)];
             for (auto& n : v) {
                 const uint64_t span = n.children_span(caps_below);
-                const uint64_t global = n.first_child() + (d >= k ? child_offset : 0);
+                const uint64_t global = n.first_child() + child_offset[i];
                 if (global + span > limit)
                     throw Error(options.source_name, caps_below ? "octree too large: more than 2^48 bytes of caps"
                                                                 : "octree too large: more than 2^32 nodes at depth " +
@@ -155,24 +205,25 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
                 OCTISO_CHECK(global + span <= next_total, "depth ", d, ": children from ", global, " past ", next_total,
                              " at depth ", d + 1);
             }
-            if (d >= k) child_offset += caps_below ? p->caps.size() : p->nodes[size_t(d + 1)].size();
-            out.stats.scalar_leaves_per_depth[size_t(d)] += p->leaves[size_t(d)];
-            move_into(out.nodes[size_t(d)], at, v);
-            if (++moved % kPiecesPerRelease == 0) release_free_memory();
-        }
+            uint64_t place = at[i];
+            move_into(out.nodes[size_t(d)], place, v);
+        });
         out.stats.nodes_per_depth[size_t(d)] = total;
     }
     uint64_t n_bytes = 0, n_caps = 0;
-    for (auto& s : sinks) n_bytes += s.caps.size(), n_caps += s.cap_count;
+    std::vector<uint64_t> cap_at(sinks.size());
+    for (size_t i = 0; i < sinks.size(); ++i) cap_at[i] = n_bytes, n_bytes += sinks[i].caps.size(), n_caps += sinks[i].cap_count;
     out.caps = UninitArray<uint8_t>::make(n_bytes + kCapReadSlack);
-    uint64_t at = 0;
-    for (auto& s : sinks) {
-        move_into(out.caps, at, s.caps);
-        if (++moved % kPiecesPerRelease == 0) release_free_memory();
-    }
-    std::fill_n(out.caps.data.get() + at, kCapReadSlack, uint8_t(0));
+    in_batches(sinks.size(), [&](size_t i) { return uint64_t(sinks[i].caps.size()); }, [&](size_t i) {
+        uint64_t place = cap_at[i];
+        move_into(out.caps, place, sinks[i].caps);
+    });
+    std::fill_n(out.caps.data.get() + n_bytes, kCapReadSlack, uint8_t(0));
     sinks = {};
-    release_free_memory();
+    release();
+    out.stats.phases = phases;
+    out.stats.phases.concatenate = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_concat).count() - release_seconds;
+    out.stats.phases.release = release_seconds;
     out.cap_bytes = n_bytes;
     out.cap_count = n_caps;
     out.stats.nodes_per_depth[size_t(dmax - 1)] = n_caps;
@@ -188,11 +239,7 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
 
 template <typename T> OctreeData<T> build_octree(const VolumeView<T>& volume, const BuildOptions& options) {
     try {
-        if (options.threads > 0) {
-            tbb::task_arena arena(options.threads);
-            return arena.execute([&] { return build_impl(volume, options); });
-        }
-        return build_impl(volume, options);
+        return in_shared_arena(options.threads, [&] { return build_impl(volume, options); });
     } catch (const std::bad_alloc&) {
         // Issue 18: a huge declared grid ran out of memory without naming its file.
         const Dims d = volume.dims;

@@ -76,6 +76,14 @@ void expect_totals_are_the_sums(const ConvertReport& r) {
     EXPECT_EQ(r.file_bytes, fs::file_size(r.output));
     EXPECT_GT(r.peak_rss_bytes, 0u);
     EXPECT_GE(r.total_seconds, r.build_seconds);
+    if (!r.streamed && !r.built_directly) {   // issue 12: the phases of an in-memory conversion
+        const BuildPhases& p = r.build_phases;
+        EXPECT_GT(p.pieces, 0.0);
+        EXPECT_LE(p.prepare + p.pieces + p.top + p.concatenate + p.release, r.build_seconds);
+        EXPECT_GT(r.read_seconds, 0.0);
+        EXPECT_GT(r.write_seconds, 0.0);
+        EXPECT_LE(r.read_seconds + r.build_seconds + r.write_seconds, r.total_seconds);
+    }
 }
 
 TEST(Convert, SyntheticSeriesDecodesStepByStepAndReportsItsSums) {

@@ -130,7 +130,8 @@ TEST_F(ConvertCli, JsonIsOneObjectThatMatchesTheFile) {
     for (const char* key : {"\"split\"", "\"interior_bytes\"", "\"cap_bytes\"", "\"minmax_bytes\"", "\"ratio\"",
                             "\"depths\"", "\"scalar_leaves\"", "\"build_seconds\"", "\"total_seconds\"",
                             "\"mvoxels_per_second\"", "\"peak_rss_bytes\"", "\"threads\"", "\"type\":\"u8\"",
-                            "\"dims\":[24,24,24]"})
+                            "\"dims\":[24,24,24]", "\"phases\"", "\"pieces\"", "\"concatenate\"", "\"release\"",
+                            "\"read\"", "\"write\""})
         EXPECT_NE(json.find(key), std::string::npos) << key;
     EXPECT_GT(json_uint(json, "peak_rss_bytes"), 0u);
 }

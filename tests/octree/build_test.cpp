@@ -1,6 +1,7 @@
 // Octree construction and hashing against the dense array it came from: point location of every
 // voxel, neighbour finding of every forward neighbour, exact min/max, tolerance, iso-range.
 #include <cmath>
+#include <cstring>
 
 #include "octiso/build.h"
 #include "octiso/error.h"
@@ -221,6 +222,36 @@ TEST(OctreeBuildLarge, ParallelPiecesMatchInputOnAnOddShape) {
     uint64_t total = 0;
     for (uint64_t n : data.stats.nodes_per_depth) total += n;
     EXPECT_GT(total, 1u);
+}
+
+TEST(OctreeBuildLarge, SameBytesOnAnyThreadCountWithEveryPhaseTimed) {
+    // Issue 12: the pieces are concatenated in parallel batches; the result must not depend on
+    // how many threads copied them, and the phases the converter reports must add up.
+    const auto v = make_volume<uint8_t>({133, 71, 90}, Pattern::Blocky, 9);
+    BuildOptions one;
+    one.threads = 1;
+    const auto reference = build_octree(v.view(), one);
+    for (int threads : {2, 3, 5}) {
+        BuildOptions options;
+        options.threads = threads;
+        const auto data = build_octree(v.view(), options);
+        ASSERT_EQ(data.nodes.size(), reference.nodes.size());
+        for (size_t d = 0; d < data.nodes.size(); ++d) {
+            ASSERT_EQ(data.nodes[d].size, reference.nodes[d].size) << "depth " << d;
+            EXPECT_EQ(std::memcmp(data.nodes[d].data.get(), reference.nodes[d].data.get(),
+                                  data.nodes[d].size * sizeof(InteriorNode<uint8_t>)), 0)
+                << "depth " << d << " on " << threads << " threads";
+        }
+        ASSERT_EQ(data.cap_bytes, reference.cap_bytes);
+        EXPECT_EQ(std::memcmp(data.caps.data.get(), reference.caps.data.get(), data.cap_bytes + kCapReadSlack), 0)
+            << threads << " threads";
+        EXPECT_EQ(data.stats.nodes_per_depth, reference.stats.nodes_per_depth);
+        EXPECT_EQ(data.stats.scalar_leaves_per_depth, reference.stats.scalar_leaves_per_depth);
+        const BuildPhases& p = data.stats.phases;
+        for (double phase : {p.prepare, p.pieces, p.top, p.concatenate, p.release}) EXPECT_GE(phase, 0.0);
+        EXPECT_GT(p.pieces, 0.0);
+        EXPECT_LE(p.prepare + p.pieces + p.top + p.concatenate + p.release, data.stats.seconds);
+    }
 }
 
 }  // namespace
