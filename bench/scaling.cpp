@@ -22,7 +22,10 @@
 #include "bench/bench.h"
 #include "octiso/build.h"
 #include "octiso/error.h"
+#include "octiso/any_octree.h"
+#if OCTISO_SCALING_READS_FILES
 #include "octiso/reader.h"
+#endif
 #include "octiso/render.h"
 #include "octiso/tiles.h"
 #include "octiso/synthetic.h"
@@ -34,8 +37,10 @@ namespace {
 
 const char* const kScalingUsage =
     "usage: octiso-bench scaling [--dataset NAME] [--size N] [--images 512,1024] [--iso V] [--repeats N]\n"
-    "                            [--max-threads N] [--mri FILE] [--quick]\n"
-    "  NAME: plume (default), mixing (synthetic N^3, default 256) or mri\n"
+    "                            [--max-threads N] [--threads 1,2,4,8,16] [--no-build] [--mri FILE] [--quick]\n"
+    "  NAME: plume (default), mixing (synthetic N^3, default 256), mri, or a .oct file (step 0; no build rows)\n"
+    "  --threads: the thread counts measured (default 1 .. --max-threads, all cores)\n"
+    "  --no-build: render rows only (the build is measured on 1..N threads for a synthetic or mri volume)\n"
     "  --quick: 128^3, images 256 and 512, 2 repeats";
 
 /// Makespan of greedy list scheduling: tiles in order, each to the worker that is free first.
@@ -102,6 +107,7 @@ struct Measured {
     std::vector<double> seconds;       // wall seconds of the tile loop (RenderStats)
     std::vector<double> cpu_seconds;   // process CPU seconds of the whole render() call
     std::vector<double> call_seconds;  // wall seconds of the whole render() call (setup included)
+    std::vector<double> busy_seconds;  // thread seconds inside tiles (RenderStats::busy_seconds)
     static double median_of(std::vector<double> s) {
         std::sort(s.begin(), s.end());
         return s.empty() ? 0 : s[s.size() / 2];
@@ -112,6 +118,38 @@ struct Measured {
         return s[s.size() / 2];
     }
 };
+
+/// One thread count of the build (in memory, the octree only: build_octree's own phases).
+struct BuildRow {
+    int threads = 0;
+    std::vector<double> seconds;
+    std::vector<BuildPhases> phases;
+    double median() const { return Measured::median_of(seconds); }
+    /// The per-phase medians.
+    BuildPhases median_phases() const {
+        const auto med = [&](double BuildPhases::*f) {
+            std::vector<double> v;
+            for (const BuildPhases& p : phases) v.push_back(p.*f);
+            return Measured::median_of(v);
+        };
+        return {med(&BuildPhases::prepare), med(&BuildPhases::pieces), med(&BuildPhases::top),
+                med(&BuildPhases::concatenate), med(&BuildPhases::release)};
+    }
+};
+
+/// The whole-call seconds of the 1-thread row of image `width`.
+std::vector<double> rows_of_width_one_call(const std::vector<Measured>& measured, int width) {
+    for (const Measured& m : measured)
+        if (m.width == width && m.threads == 1) return m.call_seconds;
+    return {};
+}
+
+/// Amdahl's bound at P threads for a run whose `serial` seconds of `total` cannot overlap.
+double amdahl_efficiency(double serial, double total, int p) {
+    if (total <= 0) return 1;
+    const double f = std::clamp(serial / total, 0.0, 1.0);
+    return 1.0 / (f * p + (1.0 - f));
+}
 
 struct Simulated {
     int width = 0, tile = 16;
@@ -174,13 +212,14 @@ int run_scaling(cli::Args& args) {
         std::cout << kScalingUsage << "\n";
         return 0;
     }
-    const bool quick = args.flag("--quick");
+    const bool quick = args.flag("--quick"), no_build = args.flag("--no-build");
     const auto ds = args.value("--dataset");
     const auto size_flag = args.value("--size");
     const auto images_flag = args.value("--images");
     const auto iso_flag = args.value("--iso");
     const auto repeats_flag = args.value("--repeats");
     const auto max_threads_flag = args.value("--max-threads");
+    const auto threads_flag = args.value("--threads");
     const auto mri_flag = args.value("--mri");
     const std::string results = results_dir(args);
     args.finish();
@@ -198,42 +237,88 @@ int run_scaling(cli::Args& args) {
     const int repeats = repeats_flag ? int(cli::parse_int(*repeats_flag, "--repeats", 1, 1000)) : quick ? 2 : 3;
     const int hw = int(std::max(1u, std::thread::hardware_concurrency()));
     const int max_threads = max_threads_flag ? int(cli::parse_int(*max_threads_flag, "--max-threads", 1, 1024)) : hw;
-    LoadedVolume volume;
-    if (name == "plume" || name == "mixing") volume = synthetic_step(name, Dims{n, n, n}, 0);
+    std::vector<int> thread_counts;
+    if (threads_flag) {
+        for (double t : cli::parse_list(*threads_flag, "--threads")) {
+            if (!(t >= 1 && t <= 1024 && t == std::floor(t))) throw Error("--threads", "expected thread counts 1 .. 1024");
+            thread_counts.push_back(int(t));
+        }
+        std::sort(thread_counts.begin(), thread_counts.end());
+        thread_counts.erase(std::unique(thread_counts.begin(), thread_counts.end()), thread_counts.end());
+        if (thread_counts.front() != 1) thread_counts.insert(thread_counts.begin(), 1);   // speed-ups are against 1
+    } else {
+        for (int p = 1; p <= max_threads; ++p) thread_counts.push_back(p);
+    }
+    // The volume (synthetic or read; the build is measured on it) or a converted file (render only).
+    const bool from_file = name.size() > 4 && name.compare(name.size() - 4, 4, ".oct") == 0;
+    std::optional<LoadedVolume> volume;
+    std::optional<AnyOctree> tree;
+    if (from_file) tree = AnyOctree::open(name);
+    else if (name == "plume" || name == "mixing") volume = synthetic_step(name, Dims{n, n, n}, 0);
+#if OCTISO_SCALING_READS_FILES
     else if (name == "mri") volume = open_volume(mri_flag ? *mri_flag : "/usr/share/mricron/templates/ch2.nii.gz", RawOptions{});
-    else throw Error("--dataset", "expected plume, mixing or mri, found '" + name + "'");
+#endif
+    else throw Error("--dataset", "expected plume, mixing, mri or a .oct file, found '" + name + "'");
+    if (!volume && mri_flag) throw Error("--mri", "only with --dataset mri");
+    if (volume) tree = AnyOctree::build(*volume, BuildOptions{});
     const double iso = iso_flag ? cli::parse_double(*iso_flag, "--iso") : default_isovalue(name);
-    const Dims dims = volume.dims();
+    const Dims dims = tree->dims();
+    const Placement placement = tree->placement();
     std::cerr << "scaling: " << name << " " << dims.x << "x" << dims.y << "x" << dims.z << ", iso " << iso << "\n";
 
-    // The machine's ceiling on 1..max_threads threads (compute-bound, so the renderer cannot beat it).
-    std::vector<double> ceiling_speedup;   // index P-1
+    // The machine's ceiling on each thread count (compute-bound, so the renderer cannot beat it).
+    std::vector<double> ceiling_speedup(size_t(thread_counts.back()), 0.0);   // index P-1; 0 where not measured
     {
         const int ceiling_repeats = quick ? 1 : 3;
         const double one = compute_bound_seconds(1, ceiling_repeats);
-        for (int p = 1; p <= max_threads; ++p)
-            ceiling_speedup.push_back(p == 1 ? 1.0 : double(p) * one / compute_bound_seconds(p, ceiling_repeats));
+        for (int p : thread_counts)
+            ceiling_speedup[size_t(p - 1)] = p == 1 ? 1.0 : double(p) * one / compute_bound_seconds(p, ceiling_repeats);
     }
+    // The nearest measured ceiling at or below P (the model's input where P was not measured).
+    const auto ceiling_at = [&](int p) {
+        for (int q = std::min(p, int(ceiling_speedup.size())); q >= 1; --q)
+            if (ceiling_speedup[size_t(q - 1)] > 0) return std::pair<int, double>(q, ceiling_speedup[size_t(q - 1)]);
+        return std::pair<int, double>(1, 1.0);
+    };
+
+    // The build on each thread count, interleaved round by round (issue 12: conversion scaling).
+    std::vector<BuildRow> builds;
+    if (volume && !no_build) {
+        for (int p : thread_counts) builds.push_back(BuildRow{p, {}, {}});
+        for (int k = 0; k < repeats; ++k)
+            for (size_t i = 0; i < builds.size(); ++i) {
+                BuildRow& b = builds[k % 2 ? builds.size() - 1 - i : i];
+                BuildOptions bo;
+                bo.threads = b.threads;
+                const auto t0 = std::chrono::steady_clock::now();
+                const AnyOctree built = AnyOctree::build(*volume, bo);
+                b.seconds.push_back(seconds_since(t0));
+                b.phases.push_back(built.info().build_phases.value_or(BuildPhases{}));
+            }
+    }
+
     std::vector<Measured> measured;
     std::vector<Simulated> simulated;
-    const std::vector<int> sim_workers = {1, 2, 4, 8, 16, 32, 64};
-    dispatch_scalar_type(volume.type(), [&](auto tag) {
+    std::vector<int> sim_workers = {1, 2, 4, 8, 16, 32, 64};
+    for (int p : thread_counts) sim_workers.push_back(p);   // the model is checked against every measured P
+    std::sort(sim_workers.begin(), sim_workers.end());
+    sim_workers.erase(std::unique(sim_workers.begin(), sim_workers.end()), sim_workers.end());
+    dispatch_scalar_type(tree->type(), [&](auto tag) {
         using T = decltype(tag);
-        const OctreeData<T> data = build_octree(volume.view<T>(), BuildOptions{});
-        const Octree<T> tree = data.view();
+        const Octree<T>& octree = *tree->as<T>();
         for (int w : widths) {
-            const Camera camera = frame_data_box(dims, volume.placement(), w, w);
+            const Camera camera = frame_data_box(dims, placement, w, w);
             RenderOptions options;
             options.isovalues = {iso};
             std::vector<Measured> rows;
-            for (int p = 1; p <= max_threads; ++p) {
+            for (int p : thread_counts) {
                 Measured m;
                 m.width = w, m.threads = p;
                 rows.push_back(m);
             }
             for (auto& r : rows) {   // warm-up
                 options.threads = r.threads;
-                render(tree, volume.placement(), camera, options);
+                render(octree, placement, camera, options);
             }
             for (int k = 0; k < repeats; ++k)
                 for (size_t i = 0; i < rows.size(); ++i) {
@@ -241,9 +326,11 @@ int run_scaling(cli::Args& args) {
                     options.threads = r.threads;
                     const double c0 = process_cpu_seconds();
                     const auto w0 = std::chrono::steady_clock::now();
-                    r.seconds.push_back(render(tree, volume.placement(), camera, options).stats.seconds);
+                    const RenderStats stats = render(octree, placement, camera, options).stats;
                     r.call_seconds.push_back(seconds_since(w0));
                     r.cpu_seconds.push_back(process_cpu_seconds() - c0);
+                    r.seconds.push_back(stats.seconds);
+                    r.busy_seconds.push_back(stats.busy_seconds);
                 }
             for (auto& r : rows) measured.push_back(r);
             // Serial per-frame time: the whole render() call minus its tile loop (one thread).
@@ -252,7 +339,7 @@ int run_scaling(cli::Args& args) {
                 serial.push_back(std::max(0.0, rows.front().call_seconds[k] - rows.front().seconds[k]));
             const double serial_seconds = Measured::median_of(serial);
 
-            const std::vector<double> blocks = block_costs(tree, volume.placement(), camera, iso, quick ? 1 : 3);
+            const std::vector<double> blocks = block_costs(octree, placement, camera, iso, quick ? 1 : 3);
             for (int ts : {16, 8}) {   // 16: the renderer's tiles; 8: what finer tiles would give
                 Simulated s;
                 s.width = w;
@@ -267,8 +354,8 @@ int run_scaling(cli::Args& args) {
                     s.dynamic_speedup.push_back(s.sum_seconds / makespan);
                     s.static_speedup.push_back(s.sum_seconds / static_makespan(cost, p));
                     s.serial_speedup.push_back((serial_seconds + s.sum_seconds) / (serial_seconds + makespan));
-                    const int q = std::min(p, int(ceiling_speedup.size()));
-                    const double ceiling_eff = ceiling_speedup[size_t(q - 1)] / q;
+                    const auto [q, ceiling] = ceiling_at(p);
+                    const double ceiling_eff = ceiling / q;
                     s.model_speedup.push_back((serial_seconds + s.sum_seconds) / (serial_seconds + makespan / ceiling_eff));
                 }
                 simulated.push_back(s);
@@ -282,28 +369,66 @@ int run_scaling(cli::Args& args) {
         std::getline(f, load);
     }
     std::cout << "machine: " << machine_description() << "; load average at the end: " << load << "\n";
-    Table mt({"image", "threads", "frames/s", "Mrays/s", "speedup", "efficiency", "CPU s/frame", "CPU-work eff.",
-              "render() setup s"});
+    // The model's speed-up at P for this image size and the renderer's 16^2 tiles.
+    const auto model_at = [&](int width, int p) {
+        for (const auto& s : simulated)
+            if (s.width == width && s.tile == 16)
+                for (size_t i = 0; i < s.workers.size(); ++i)
+                    if (s.workers[i] == p) return s.model_speedup[i];
+        return 0.0;
+    };
+    Table mt({"image", "threads", "frames/s", "Mrays/s", "speedup", "efficiency", "utilisation", "busy / busy(1)",
+              "CPU s/frame", "CPU-work eff.", "render() setup s", "model eff.", "measured - model"});
     for (const auto& m : measured) {
-        double one = 0, one_cpu = 0;
+        double one = 0, one_cpu = 0, one_busy = 0;
         for (const auto& o : measured)
-            if (o.width == m.width && o.threads == 1) one = o.median(), one_cpu = Measured::median_of(o.cpu_seconds);
+            if (o.width == m.width && o.threads == 1)
+                one = o.median(), one_cpu = Measured::median_of(o.cpu_seconds), one_busy = Measured::median_of(o.busy_seconds);
         const double speedup = one / m.median();
-        const double cpu = Measured::median_of(m.cpu_seconds);
+        const double cpu = Measured::median_of(m.cpu_seconds), busy = Measured::median_of(m.busy_seconds);
+        const double model_eff = model_at(m.width, m.threads) / m.threads;
+        // The wall-clock speed-up counts the whole render() call, as the model does (serial set-up included).
+        const double call_speedup = Measured::median_of(rows_of_width_one_call(measured, m.width)) /
+                                    Measured::median_of(m.call_seconds);
         mt.add({std::to_string(m.width) + "^2", std::to_string(m.threads), fmt(1.0 / m.median(), 2),
                 fmt(double(m.width) * m.width / m.median() * 1e-6, 2), fmt(speedup, 3), fmt(100.0 * speedup / m.threads, 1) + " %",
+                fmt(100.0 * busy / (m.threads * m.median()), 1) + " %", fmt(one_busy > 0 ? busy / one_busy : 0.0, 3),
                 fmt(cpu, 3), fmt(100.0 * one_cpu / cpu, 1) + " %",
-                fmt(Measured::median_of(m.call_seconds) - m.median(), 4)});
+                fmt(Measured::median_of(m.call_seconds) - m.median(), 4), fmt(100.0 * model_eff, 1) + " %",
+                fmt(100.0 * (call_speedup / m.threads - model_eff), 1) + " pt"});
     }
     std::cout << "measured (render(), Embree path, colour, median of " << repeats << " interleaved repeats); "
-                 "CPU-work eff. = process CPU of 1 thread / process CPU of P threads (not distorted by other "
-                 "processes, but blind to idle waiting)\n";
+                 "efficiency = tile-loop speedup / P; utilisation = thread seconds inside tiles / (P x tile-loop "
+                 "wall); busy / busy(1) > 1 is each tile costing more on P threads (shared caches, memory), not "
+                 "scheduling; CPU-work eff. = process CPU of 1 thread / process CPU of P threads; model eff. = the "
+                 "simulated schedule + serial set-up + measured ceiling at P, against the measured whole-call "
+                 "efficiency (measured - model)\n";
     mt.print(std::cout);
     std::cout << "\n";
     mt.print_markdown(std::cout);
+    if (!builds.empty()) {
+        const double one = builds.front().median();
+        const BuildPhases p1 = builds.front().median_phases();
+        const double serial1 = p1.top + p1.release;
+        Table bt({"threads", "build s", "Mvox/s", "speedup", "efficiency", "prepare s", "pieces s", "top s",
+                  "concatenate s", "release s", "serial s (top + release)", "Amdahl bound eff. from 1-thread serial"});
+        for (const BuildRow& b : builds) {
+            const BuildPhases ph = b.median_phases();
+            const double speedup = one / b.median();
+            bt.add({std::to_string(b.threads), fmt(b.median(), 3), fmt(double(dims.voxels()) / b.median() * 1e-6, 1),
+                    fmt(speedup, 3), fmt(100.0 * speedup / b.threads, 1) + " %", fmt(ph.prepare, 4), fmt(ph.pieces, 4),
+                    fmt(ph.top, 4), fmt(ph.concatenate, 4), fmt(ph.release, 4), fmt(ph.top + ph.release, 4),
+                    fmt(100.0 * amdahl_efficiency(serial1, one, b.threads), 1) + " %"});
+        }
+        std::cout << "\nbuild (build_octree in memory, " << dims.x << "x" << dims.y << "x" << dims.z
+                  << ", median of " << repeats << " interleaved repeats; phases from BuildStats::phases)\n";
+        bt.print(std::cout);
+        std::cout << "\n";
+        bt.print_markdown(std::cout);
+    }
     Table ct({"threads", "compute-bound speedup (measured ceiling)", "ceiling eff."});
-    for (size_t i = 0; i < ceiling_speedup.size(); ++i)
-        ct.add({std::to_string(i + 1), fmt(ceiling_speedup[i], 3), fmt(100.0 * ceiling_speedup[i] / double(i + 1), 1) + " %"});
+    for (int p : thread_counts)
+        ct.add({std::to_string(p), fmt(ceiling_speedup[size_t(p - 1)], 3), fmt(100.0 * ceiling_speedup[size_t(p - 1)] / p, 1) + " %"});
     std::cout << "\nmachine ceiling (measured): a compute-bound loop of fixed length per thread\n";
     ct.print(std::cout);
     std::cout << "\n";
@@ -319,7 +444,7 @@ int run_scaling(cli::Args& args) {
                     fmt(100.0 * s.model_speedup[i] / s.workers[i], 1) + " %"});
     std::cout << "\nSIMULATED schedule of measured tile costs (no scheduling overhead; the last two columns add the "
                  "measured serial per-frame time and the measured machine ceiling, which beyond "
-              << ceiling_speedup.size() << " threads is assumed to stay at its " << ceiling_speedup.size()
+              << thread_counts.back() << " threads is assumed to stay at its " << thread_counts.back()
               << "-thread value)\n";
     st.print(std::cout);
     std::cout << "\n";
@@ -327,17 +452,30 @@ int run_scaling(cli::Args& args) {
 
     const std::string json = write_json(results, "scaling", [&](cli::JsonWriter& j) {
         j.begin_object();
-        j.field("machine", machine_description()).field("dataset", name).field("source", volume.source());
+        j.field("machine", machine_description()).field("dataset", name).field("source", tree->info().source);
         j.key("dims").array(std::vector<uint32_t>{dims.x, dims.y, dims.z});
         j.field("iso", iso).field("repeats", repeats).field("loadavg", load);
-        j.key("ceiling_speedup").array(ceiling_speedup);   // measured, index = threads - 1
+        j.key("threads").array(thread_counts);
+        j.key("ceiling_speedup").array(ceiling_speedup);   // measured, index = threads - 1 (0: not measured)
         j.key("measured").begin_array();
         for (const auto& m : measured) {
             j.begin_object();
             j.field("width", m.width).field("threads", m.threads).field("median_seconds", m.median());
             j.key("seconds").array(m.seconds);
+            j.key("busy_seconds").array(m.busy_seconds);
             j.key("cpu_seconds").array(m.cpu_seconds);
             j.key("call_seconds").array(m.call_seconds);
+            j.field("model_speedup", model_at(m.width, m.threads));
+            j.end_object();
+        }
+        j.end_array();
+        j.key("build").begin_array();
+        for (const BuildRow& b : builds) {
+            j.begin_object().field("threads", b.threads).field("median_seconds", b.median());
+            j.key("seconds").array(b.seconds);
+            const BuildPhases ph = b.median_phases();
+            j.key("phases").begin_object().field("prepare", ph.prepare).field("pieces", ph.pieces).field("top", ph.top)
+                .field("concatenate", ph.concatenate).field("release", ph.release).end_object();
             j.end_object();
         }
         j.end_array();

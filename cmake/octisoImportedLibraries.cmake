@@ -4,17 +4,16 @@
 # consumer of the installed package find the same files. Each function defines its target when
 # the library is found and leaves it undefined otherwise; the caller decides whether that is fatal.
 
-# octiso_deps::xxhash: libxxhash (XXH3 section checksums of the .oct format; core).
+# octiso_deps::xxhash: xxhash.h (XXH3 section checksums of the .oct format, compiled into core).
 function(octiso_import_xxhash)
   if(TARGET octiso_deps::xxhash)
     return()
   endif()
+  # Header only: validate.cpp compiles XXH3 in (XXH_INLINE_ALL), so nothing links libxxhash.
   find_path(OCTISO_XXHASH_INCLUDE_DIR xxhash.h)
-  find_library(OCTISO_XXHASH_LIBRARY xxhash)
-  if(OCTISO_XXHASH_INCLUDE_DIR AND OCTISO_XXHASH_LIBRARY)
-    add_library(octiso_deps::xxhash UNKNOWN IMPORTED)
-    set_target_properties(octiso_deps::xxhash PROPERTIES IMPORTED_LOCATION "${OCTISO_XXHASH_LIBRARY}"
-                          INTERFACE_INCLUDE_DIRECTORIES "${OCTISO_XXHASH_INCLUDE_DIR}")
+  if(OCTISO_XXHASH_INCLUDE_DIR)
+    add_library(octiso_deps::xxhash INTERFACE IMPORTED)
+    set_target_properties(octiso_deps::xxhash PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${OCTISO_XXHASH_INCLUDE_DIR}")
   endif()
 endfunction()
 

@@ -12,6 +12,10 @@
 #include <vector>
 
 #include <tbb/parallel_for.h>
+// XXH3 compiled in from the header (its documented XXH_INLINE_ALL mode), not linked from
+// libxxhash: the many-core probe then needs no library beyond TBB and Embree (issue 12); the
+// hash values are the same algorithm's.
+#define XXH_INLINE_ALL
 #include <xxhash.h>
 
 #include "octiso/error.h"
