@@ -6,7 +6,10 @@ import re
 import subprocess
 import sys
 
-ALLOWED = re.compile(r"^(libtbb|libembree|libc\.so|libm\.so|libstdc\+\+|libgcc_s|libpthread|libdl|librt|ld-linux)")
+# The C/C++ runtimes, and the sanitizer runtimes of an ASan/UBSan/TSan build (the compiler's own;
+# the probe that travels is a Release build).
+ALLOWED = re.compile(r"^(libtbb|libembree|libc\.so|libm\.so|libstdc\+\+|libgcc_s|libpthread|libdl|librt|ld-linux|"
+                     r"libasan|libubsan|libtsan)")
 
 
 def main(binary):
