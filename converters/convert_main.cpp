@@ -217,7 +217,7 @@ void write_json(std::ostream& os, const ConvertReport& r, const std::optional<st
     j.field("build_seconds", r.build_seconds).field("total_seconds", r.total_seconds);
     if (!r.streamed && !r.built_directly) {   // issue 12: which parts of the conversion are serial
         const BuildPhases& p = r.build_phases;
-        j.key("phases").begin_object().field("read", r.read_seconds).field("prepare", p.prepare).field("pieces", p.pieces)
+        j.key("phases").begin_object().field("read", r.read_seconds).field("prepare", p.prepare).field("pieces", p.pieces).field("pieces_busy", p.pieces_busy)
             .field("top", p.top).field("concatenate", p.concatenate).field("release", p.release)
             .field("write", r.write_seconds).end_object();
     }

@@ -34,8 +34,11 @@ struct BuildOptions {
 /// octiso-convert --json on any machine). pieces is the parallel bulk; prepare is parallel too;
 /// top is serial and small; concatenate copies the pieces' arrays into the final ones (parallel
 /// over pieces in batches) and release is the malloc_trim between batches (serial).
+/// pieces_busy is the thread seconds inside pieces: pieces_busy / (threads x pieces) is that
+/// phase's utilisation, and its growth with the thread count is each piece costing more.
 struct BuildPhases {
     double prepare = 0, pieces = 0, top = 0, concatenate = 0, release = 0;
+    double pieces_busy = 0;
 };
 
 /// Counts per depth d = 0 .. dmax-1: stored nodes (interior; caps at dmax-1) and scalar leaves

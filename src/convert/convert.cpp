@@ -290,6 +290,7 @@ ConvertReport convert(const ConvertSource& source, const std::string& output, co
         if (const auto& p = built.build_phases) {
             r.build_phases.prepare += p->prepare, r.build_phases.pieces += p->pieces, r.build_phases.top += p->top;
             r.build_phases.concatenate += p->concatenate, r.build_phases.release += p->release;
+            r.build_phases.pieces_busy += p->pieces_busy;
         }
         add_sizes(r.total, step.sizes);
         const Clock::time_point t_write = Clock::now();

@@ -17,6 +17,7 @@
 // ranges of its 8 blocks from it: about 2 reads per voxel instead of 27/8 per block voxel.
 // Padding beyond the data never enters a range and never blocks a merge ("don't care").
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -104,8 +105,14 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
     sinks.reserve(origins.size());
     for (size_t i = 0; i < origins.size(); ++i) sinks.emplace_back(dmax);
     std::vector<Summary<T>> roots(origins.size());
-    tbb::parallel_for(size_t(0), origins.size(), [&](size_t i) { roots[i] = builder.build(k, origins[i], sinks[i]); });
+    std::atomic<uint64_t> pieces_busy_ns{0};   // each piece's own wall time (two clock reads a piece)
+    tbb::parallel_for(size_t(0), origins.size(), [&](size_t i) {
+        const auto started = std::chrono::steady_clock::now();
+        roots[i] = builder.build(k, origins[i], sinks[i]);
+        pieces_busy_ns += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - started).count());
+    });
     phase_done(phases.pieces);
+    phases.pieces_busy = double(pieces_busy_ns.load()) * 1e-9;
 
     // 2. The top: the same descent, taking each depth-k summary from its piece. A depth-(k-1)
     //    node's child_start counts the piece roots stored before it.
