@@ -15,6 +15,7 @@
 #include "cli/common/cli.h"
 #include "cli/common/flags.h"
 #include "cli/common/json.h"
+#include "cli/frame_writer.h"
 #include "cli/common/output_path.h"
 #include "cli/common/progress.h"
 #include "cli/common/report.h"
@@ -343,6 +344,12 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     long long renderer_step = -1;
     uint64_t ghost_bytes = 0;   // sent with the latest step's ghost exchange
     std::vector<FrameRecord> records;   // this rank's frames
+    std::vector<size_t> job_of_record;  // the job each record is of
+    // Issue 12: with more than one frame, the images are written on a thread of their own while
+    // the next frame renders; each frame's write time lands in write_seconds[job].
+    std::vector<double> write_seconds(jobs.size(), 0.0);
+    std::optional<cli::FrameWriter> writer;
+    if (jobs.size() > 1) writer.emplace();
     const auto wall_start = std::chrono::steady_clock::now();
     const auto render_job = [&](size_t n) {
         const Job& job = jobs[n];
@@ -408,12 +415,22 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         record.hits = frame.stats.hits;
         if (!open_to_first_frame) open_to_first_frame = std::chrono::duration<double>(std::chrono::steady_clock::now() - open_start).count();
         file->check_unchanged();   // issue 18: never publish a frame of a file rewritten under us
+        const int frame_width = frame.width, frame_height = frame.height;
         if (root || !split_frames) {
-            const auto write_start = std::chrono::steady_clock::now();
-            if (out_path) write_colour_image(name_for(out_path, "-o", job.index), frame);
-            if (depth_path) write_depth_image(name_for(depth_path, "--depth", job.index), frame);
-            if (normal_path) write_normal_image(name_for(normal_path, "--normal", job.index), frame);
-            record.write_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
+            const long long index = job.index;
+            const auto write = [&, index](const Frame& f) {
+                if (out_path) write_colour_image(name_for(out_path, "-o", index), f);
+                if (depth_path) write_depth_image(name_for(depth_path, "--depth", index), f);
+                if (normal_path) write_normal_image(name_for(normal_path, "--normal", index), f);
+            };
+            if (writer) {   // written while the next frame renders (cli/frame_writer.h)
+                writer->submit(std::move(frame), write, &write_seconds[n]);
+                if (records.empty()) writer->finish();   // the first image before the camera line
+            } else {
+                const auto write_start = std::chrono::steady_clock::now();
+                write(frame);
+                write_seconds[n] = std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
+            }
             record.wrote = true;
         }
         // The effective camera, as flags that reproduce it (issue 17: a view can be pasted back);
@@ -427,13 +444,14 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             std::fprintf(stderr, "%s%s%s: %dx%d in %.3f s (%.2f Mrays/s, %llu hits, %d threads%s)%s\n",
                          rank_count > 1 && !split_frames ? ("rank " + std::to_string(rank) + ": ").c_str() : "",
                          series ? ((orbit ? "frame " : "step ") + std::to_string(job.index) + " ").c_str() : "",
-                         out_path ? name_for(out_path, "-o", job.index).c_str() : "frame", frame.width, frame.height,
+                         out_path ? name_for(out_path, "-o", job.index).c_str() : "frame", frame_width, frame_height,
                          record.seconds, record.seconds > 0 ? double(record.rays) / record.seconds * 1e-6 : 0.0,
                          (unsigned long long)record.hits, record.threads,
                          spp > 1 ? (", " + std::to_string(spp) + " samples per pixel").c_str() : "",
                          orbit ? (" eye " + cli::numbers(job.camera->eye)).c_str() : "");
         if (look_shader && (root || !split_frames) && (!series || !::isatty(2))) cli::print_look_stats(record.look);
         records.push_back(record);
+        job_of_record.push_back(n);
     };
     if (!split_frames && rank_count > 1) {
         // Series across ranks: rank 0 deals the jobs one at a time to whichever rank is free.
@@ -441,6 +459,8 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     } else {
         for (size_t n = 0; n < jobs.size(); ++n) render_job(n);
     }
+    if (writer) writer->finish();
+    for (size_t i = 0; i < records.size(); ++i) records[i].write_seconds = write_seconds[job_of_record[i]];
     progress.break_line();
     const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     // Rank 0 learns every rank's frames: all of them (steps), or each rank's share of each frame.
@@ -482,7 +502,8 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
             // Issue 12: where the frame's time goes. trace is the tile loops (parallel; busy is its
             // thread seconds, utilisation busy / (threads x trace)); shade the deferred passes;
             // other the rest of the frame (buffers, antialiasing sums, the MPI exchange); write
-            // the image files; step_setup the Renderer of a new step (first frame of a step).
+            // the image files (for a series or an orbit on the writer thread, while the next frame
+            // renders: not part of frame_seconds); step_setup the Renderer of a new step.
             j.key("phases").begin_object().field("trace", r.seconds).field("trace_busy", r.busy_seconds)
                 .field("utilisation", r.seconds > 0 && r.threads > 0 ? r.busy_seconds / (r.seconds * r.threads) : 0.0)
                 .field("shade", r.shade_seconds).field("other", std::max(0.0, r.frame_seconds - r.seconds - r.shade_seconds))
