@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <queue>
@@ -133,7 +134,7 @@ struct BuildRow {
             return Measured::median_of(v);
         };
         return {med(&BuildPhases::prepare), med(&BuildPhases::pieces), med(&BuildPhases::top),
-                med(&BuildPhases::concatenate), med(&BuildPhases::release)};
+                med(&BuildPhases::concatenate), med(&BuildPhases::release), med(&BuildPhases::pieces_busy)};
     }
 };
 
@@ -410,14 +411,16 @@ int run_scaling(cli::Args& args) {
         const double one = builds.front().median();
         const BuildPhases p1 = builds.front().median_phases();
         const double serial1 = p1.top + p1.release;
-        Table bt({"threads", "build s", "Mvox/s", "speedup", "efficiency", "prepare s", "pieces s", "top s",
-                  "concatenate s", "release s", "serial s (top + release)", "Amdahl bound eff. from 1-thread serial"});
+        Table bt({"threads", "build s", "Mvox/s", "speedup", "efficiency", "prepare s", "pieces s", "pieces util.",
+                  "piece busy / busy(1)", "top s", "concatenate s", "release s", "serial s (top + release)",
+                  "Amdahl bound eff. from 1-thread serial"});
         for (const BuildRow& b : builds) {
             const BuildPhases ph = b.median_phases();
             const double speedup = one / b.median();
             bt.add({std::to_string(b.threads), fmt(b.median(), 3), fmt(double(dims.voxels()) / b.median() * 1e-6, 1),
                     fmt(speedup, 3), fmt(100.0 * speedup / b.threads, 1) + " %", fmt(ph.prepare, 4), fmt(ph.pieces, 4),
-                    fmt(ph.top, 4), fmt(ph.concatenate, 4), fmt(ph.release, 4), fmt(ph.top + ph.release, 4),
+                    fmt(ph.pieces > 0 ? 100.0 * ph.pieces_busy / (b.threads * ph.pieces) : 0.0, 1) + " %",
+                    fmt(p1.pieces_busy > 0 ? ph.pieces_busy / p1.pieces_busy : 0.0, 3), fmt(ph.top, 4), fmt(ph.concatenate, 4), fmt(ph.release, 4), fmt(ph.top + ph.release, 4),
                     fmt(100.0 * amdahl_efficiency(serial1, one, b.threads), 1) + " %"});
         }
         std::cout << "\nbuild (build_octree in memory, " << dims.x << "x" << dims.y << "x" << dims.z
@@ -450,7 +453,10 @@ int run_scaling(cli::Args& args) {
     std::cout << "\n";
     st.print_markdown(std::cout);
 
-    const std::string json = write_json(results, "scaling", [&](cli::JsonWriter& j) {
+    // scaling_plume_512.json, scaling_ch2better.json (a .oct by its stem): one file per dataset.
+    const std::string stem = from_file ? std::filesystem::path(name).stem().string()
+                                       : name + (name == "mri" ? "" : "_" + std::to_string(n));
+    const std::string json = write_json(results, "scaling_" + stem, [&](cli::JsonWriter& j) {
         j.begin_object();
         j.field("machine", machine_description()).field("dataset", name).field("source", tree->info().source);
         j.key("dims").array(std::vector<uint32_t>{dims.x, dims.y, dims.z});
@@ -474,7 +480,7 @@ int run_scaling(cli::Args& args) {
             j.begin_object().field("threads", b.threads).field("median_seconds", b.median());
             j.key("seconds").array(b.seconds);
             const BuildPhases ph = b.median_phases();
-            j.key("phases").begin_object().field("prepare", ph.prepare).field("pieces", ph.pieces).field("top", ph.top)
+            j.key("phases").begin_object().field("prepare", ph.prepare).field("pieces", ph.pieces).field("pieces_busy", ph.pieces_busy).field("top", ph.top)
                 .field("concatenate", ph.concatenate).field("release", ph.release).end_object();
             j.end_object();
         }
@@ -496,7 +502,7 @@ int run_scaling(cli::Args& args) {
         j.end_object();
     });
     std::cerr << "results: " << json << "\n";
-    plot("scaling", json, results + "/scaling.png");
+    plot("scaling", json, results + "/scaling_" + stem + ".png");
     return 0;
 }
 

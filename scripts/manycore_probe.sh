@@ -40,7 +40,7 @@ case $mode in
     for data in plume mixing; do
       "$kit/octiso-probe" scaling --dataset "$data" --size "$size" --images "$images" --threads "$threads" \
         --repeats "$repeats" --results "$results/$data" 2>&1
-      cp "$results/$data/scaling.json" "$results/scaling_${data}_${size}.json"
+      cp "$results/$data/scaling_${data}_${size}.json" "$results/"
     done
     ;;
   *)
