@@ -38,9 +38,11 @@ namespace {
 
 const char* const kScalingUsage =
     "usage: octiso-bench scaling [--dataset NAME] [--size N] [--images 512,1024] [--iso V] [--repeats N]\n"
-    "                            [--max-threads N] [--threads 1,2,4,8,16] [--no-build] [--mri FILE] [--quick]\n"
+    "                            [--max-threads N] [--threads 1,2,4,8,16] [--tile-order split|sweep|both] [--no-build]\n"
+    "                            [--mri FILE] [--quick]\n"
     "  NAME: plume (default), mixing (synthetic N^3, default 256), mri, or a .oct file (step 0; no build rows)\n"
     "  --threads: the thread counts measured (default 1 .. --max-threads, all cores)\n"
+    "  --tile-order: how tiles go to threads (tiles.h; default split, the renderer's); both: rows of each\n"
     "  --no-build: render rows only (the build is measured on 1..N threads for a synthetic or mri volume)\n"
     "  --quick: 128^3, images 256 and 512, 2 repeats";
 
@@ -105,6 +107,7 @@ double process_cpu_seconds() {
 
 struct Measured {
     int width = 0, threads = 0;
+    TileOrder order = TileOrder::split;
     std::vector<double> seconds;       // wall seconds of the tile loop (RenderStats)
     std::vector<double> cpu_seconds;   // process CPU seconds of the whole render() call
     std::vector<double> call_seconds;  // wall seconds of the whole render() call (setup included)
@@ -138,12 +141,14 @@ struct BuildRow {
     }
 };
 
-/// The whole-call seconds of the 1-thread row of image `width`.
+/// The whole-call seconds of the first 1-thread row of image `width` (the first order's).
 std::vector<double> rows_of_width_one_call(const std::vector<Measured>& measured, int width) {
     for (const Measured& m : measured)
         if (m.width == width && m.threads == 1) return m.call_seconds;
     return {};
 }
+
+const char* order_name(TileOrder order) { return order == TileOrder::sweep ? "sweep" : "split"; }
 
 /// Amdahl's bound at P threads for a run whose `serial` seconds of `total` cannot overlap.
 double amdahl_efficiency(double serial, double total, int p) {
@@ -221,6 +226,7 @@ int run_scaling(cli::Args& args) {
     const auto repeats_flag = args.value("--repeats");
     const auto max_threads_flag = args.value("--max-threads");
     const auto threads_flag = args.value("--threads");
+    const auto order_flag = args.value("--tile-order");
     const auto mri_flag = args.value("--mri");
     const std::string results = results_dir(args);
     args.finish();
@@ -249,6 +255,12 @@ int run_scaling(cli::Args& args) {
         if (thread_counts.front() != 1) thread_counts.insert(thread_counts.begin(), 1);   // speed-ups are against 1
     } else {
         for (int p = 1; p <= max_threads; ++p) thread_counts.push_back(p);
+    }
+    std::vector<TileOrder> orders{TileOrder::split};
+    if (order_flag) {
+        if (*order_flag == "sweep") orders = {TileOrder::sweep};
+        else if (*order_flag == "both") orders = {TileOrder::split, TileOrder::sweep};
+        else if (*order_flag != "split") throw Error("--tile-order", "expected split, sweep or both, found '" + *order_flag + "'");
     }
     // The volume (synthetic or read; the build is measured on it) or a converted file (render only).
     const bool from_file = name.size() > 4 && name.compare(name.size() - 4, 4, ".oct") == 0;
@@ -311,20 +323,23 @@ int run_scaling(cli::Args& args) {
             const Camera camera = frame_data_box(dims, placement, w, w);
             RenderOptions options;
             options.isovalues = {iso};
-            std::vector<Measured> rows;
-            for (int p : thread_counts) {
-                Measured m;
-                m.width = w, m.threads = p;
-                rows.push_back(m);
-            }
+            std::vector<Measured> rows;   // the orders' rows interleave round by round
+            for (TileOrder order : orders)
+                for (int p : thread_counts) {
+                    Measured m;
+                    m.width = w, m.threads = p, m.order = order;
+                    rows.push_back(m);
+                }
             for (auto& r : rows) {   // warm-up
                 options.threads = r.threads;
+                options.tile_order = r.order;
                 render(octree, placement, camera, options);
             }
             for (int k = 0; k < repeats; ++k)
                 for (size_t i = 0; i < rows.size(); ++i) {
                     auto& r = rows[k % 2 ? rows.size() - 1 - i : i];   // alternate the order per round
                     options.threads = r.threads;
+                    options.tile_order = r.order;
                     const double c0 = process_cpu_seconds();
                     const auto w0 = std::chrono::steady_clock::now();
                     const RenderStats stats = render(octree, placement, camera, options).stats;
@@ -378,12 +393,12 @@ int run_scaling(cli::Args& args) {
                     if (s.workers[i] == p) return s.model_speedup[i];
         return 0.0;
     };
-    Table mt({"image", "threads", "frames/s", "Mrays/s", "speedup", "efficiency", "utilisation", "busy / busy(1)",
+    Table mt({"image", "tiles to threads", "threads", "frames/s", "Mrays/s", "speedup", "efficiency", "utilisation", "busy / busy(1)",
               "CPU s/frame", "CPU-work eff.", "render() setup s", "model eff.", "measured - model"});
     for (const auto& m : measured) {
         double one = 0, one_cpu = 0, one_busy = 0;
-        for (const auto& o : measured)
-            if (o.width == m.width && o.threads == 1)
+        for (const auto& o : measured)   // against 1 thread of the first order (split, where measured)
+            if (o.width == m.width && o.threads == 1 && o.order == orders.front())
                 one = o.median(), one_cpu = Measured::median_of(o.cpu_seconds), one_busy = Measured::median_of(o.busy_seconds);
         const double speedup = one / m.median();
         const double cpu = Measured::median_of(m.cpu_seconds), busy = Measured::median_of(m.busy_seconds);
@@ -391,7 +406,7 @@ int run_scaling(cli::Args& args) {
         // The wall-clock speed-up counts the whole render() call, as the model does (serial set-up included).
         const double call_speedup = Measured::median_of(rows_of_width_one_call(measured, m.width)) /
                                     Measured::median_of(m.call_seconds);
-        mt.add({std::to_string(m.width) + "^2", std::to_string(m.threads), fmt(1.0 / m.median(), 2),
+        mt.add({std::to_string(m.width) + "^2", order_name(m.order), std::to_string(m.threads), fmt(1.0 / m.median(), 2),
                 fmt(double(m.width) * m.width / m.median() * 1e-6, 2), fmt(speedup, 3), fmt(100.0 * speedup / m.threads, 1) + " %",
                 fmt(100.0 * busy / (m.threads * m.median()), 1) + " %", fmt(one_busy > 0 ? busy / one_busy : 0.0, 3),
                 fmt(cpu, 3), fmt(100.0 * one_cpu / cpu, 1) + " %",
@@ -453,9 +468,11 @@ int run_scaling(cli::Args& args) {
     std::cout << "\n";
     st.print_markdown(std::cout);
 
-    // scaling_plume_512.json, scaling_ch2better.json (a .oct by its stem): one file per dataset.
-    const std::string stem = from_file ? std::filesystem::path(name).stem().string()
-                                       : name + (name == "mri" ? "" : "_" + std::to_string(n));
+    // scaling_plume_512.json, scaling_ch2better.json (a .oct by its stem): one file per dataset,
+    // with _split_sweep or _sweep when the tile order is not only the default.
+    const std::string stem = (from_file ? std::filesystem::path(name).stem().string()
+                                        : name + (name == "mri" ? "" : "_" + std::to_string(n))) +
+                             (orders.size() > 1 ? "_split_sweep" : orders.front() == TileOrder::sweep ? "_sweep" : "");
     const std::string json = write_json(results, "scaling_" + stem, [&](cli::JsonWriter& j) {
         j.begin_object();
         j.field("machine", machine_description()).field("dataset", name).field("source", tree->info().source);
@@ -466,7 +483,8 @@ int run_scaling(cli::Args& args) {
         j.key("measured").begin_array();
         for (const auto& m : measured) {
             j.begin_object();
-            j.field("width", m.width).field("threads", m.threads).field("median_seconds", m.median());
+            j.field("width", m.width).field("tile_order", std::string(order_name(m.order))).field("threads", m.threads)
+                .field("median_seconds", m.median());
             j.key("seconds").array(m.seconds);
             j.key("busy_seconds").array(m.busy_seconds);
             j.key("cpu_seconds").array(m.cpu_seconds);

@@ -6,13 +6,14 @@
 #                                                         libraries it needs (not the C/C++ runtimes)
 #                                                         into KIT_DIR (default .probe, git-ignored)
 #   scripts/manycore_probe.sh run [KIT_DIR] [RESULTS_DIR] there: plume and mixing 512^3 at 512^2 and
-#                                                         1024^2 on 1..16 threads, the build on the
-#                                                         same counts, the machine's compute ceiling;
+#                                                         1024^2 on 1..16 threads, both tile orders,
+#                                                         the build on the same counts, the machine's
+#                                                         compute ceiling;
 #                                                         tables on stdout, scaling_*.json in RESULTS_DIR
 #
 # With the device tool: pack here, then run with carry [".probe"] and RESULTS_DIR=$OUT. One run of
-# both datasets takes about 4-6 minutes of a 16-core machine (THREADS, SIZE, IMAGES and REPEATS
-# override the defaults below).
+# both datasets takes about 4-6 minutes of a 16-core machine (THREADS, SIZE, IMAGES, REPEATS and
+# ORDER override the defaults below).
 set -euo pipefail
 mode=${1:-}
 case $mode in
@@ -39,8 +40,8 @@ case $mode in
     nproc; grep -m1 'model name' /proc/cpuinfo || true
     for data in plume mixing; do
       "$kit/octiso-probe" scaling --dataset "$data" --size "$size" --images "$images" --threads "$threads" \
-        --repeats "$repeats" --results "$results/$data" 2>&1
-      cp "$results/$data/scaling_${data}_${size}.json" "$results/"
+        --repeats "$repeats" --tile-order "${ORDER:-both}" --results "$results/$data" 2>&1
+      cp "$results/$data"/scaling_*.json "$results/"
     done
     ;;
   *)

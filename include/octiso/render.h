@@ -69,6 +69,7 @@ struct RenderOptions {
     std::shared_ptr<const std::vector<double>> ghost_plane;
     int threads = 0;                    ///< 0: all cores
     int tile_size = 0;                  ///< square tile side in pixels; 0: tile_size_for() picks it
+    TileOrder tile_order = TileOrder::split;   ///< expert: how tiles go to threads (tiles.h); same pixels
     /// Every ray's interval is cut to the intersection of these half-spaces before traversal
     /// (src/render/clip.h); empty: no clipping, the frames of before bit for bit.
     std::vector<ClipPlane> clip_planes;

@@ -12,6 +12,15 @@ struct PixelRect {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;   ///< pixels [x0, x1) x [y0, y1), row 0 at the top
 };
 
+/// How the tile loop hands tiles to threads (issue 12; both give the same pixels). split: TBB's
+/// recursive halving of the tile range, so each thread works through its own stretch of the
+/// image (the default, measured since issue 5). sweep: one shared counter in row-major order, so
+/// all threads trace neighbouring tiles at the same time and share the octree nodes in the
+/// caches they have in common. Which scales better on many cores is for the 16-core machine to
+/// tell (octiso-bench scaling --tile-order both); on 2 threads sweep is 0.88-1.05 x split, alike
+/// within noise (BENCHMARKS.md "Many-core").
+enum class TileOrder { split, sweep };
+
 struct TileGrid {
     int width = 0, height = 0, side = 16;
 

@@ -150,7 +150,7 @@ public:
         return in_arena([&] {
             return for_each_tile(grid, tiles, all, [&](const PixelRect& rect, TileCounters& counters) {
                 trace_rect(kernel_, scene, pinhole, options, rect, frame, counters);
-            });
+            }, options.tile_order);
         });
     }
 

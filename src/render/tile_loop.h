@@ -6,6 +6,7 @@
 // 16x16 tile takes), so the loop's utilisation is measured on every frame (issue 12).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -27,29 +28,42 @@ struct TileCounters {
 };
 
 /// Runs body(const PixelRect&, TileCounters&) for the tiles `tiles` of `grid` (all tiles when
-/// `all`), in parallel; returns the wall time and the summed counters.
-template <class Body> RenderStats for_each_tile(const TileGrid& grid, std::span<const int> tiles, bool all, Body&& body) {
+/// `all`), in parallel, handed out in `order`; returns the wall time and the summed counters.
+template <class Body>
+RenderStats for_each_tile(const TileGrid& grid, std::span<const int> tiles, bool all, Body&& body,
+                          TileOrder order = TileOrder::split) {
     std::atomic<uint64_t> rays{0}, hits{0}, busy_ns{0};
     std::array<std::atomic<uint64_t>, 32> by_cell{};
     const int n = all ? grid.count() : int(tiles.size());
+    const auto run_tile = [&](int i) {
+        TileCounters local;
+        const int tile = all ? i : tiles[size_t(i)];
+        OCTISO_DCHECK(tile >= 0 && tile < grid.count(), "tile ", tile, " of ", grid.count());
+        const auto started = std::chrono::steady_clock::now();
+        body(grid.rect(tile), local);
+        busy_ns += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - started).count());
+        rays += local.rays;
+        hits += local.hits;
+        for (size_t k = 0; k < by_cell.size(); ++k)
+            if (local.hits_by_cell_log2[k]) by_cell[k] += local.hits_by_cell_log2[k];
+    };
     const auto t0 = std::chrono::steady_clock::now();
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, n, 1),
-        [&](const tbb::blocked_range<int>& range) {
-            for (int i = range.begin(); i < range.end(); ++i) {
-                TileCounters local;
-                const int tile = all ? i : tiles[size_t(i)];
-                OCTISO_DCHECK(tile >= 0 && tile < grid.count(), "tile ", tile, " of ", grid.count());
-                const auto started = std::chrono::steady_clock::now();
-                body(grid.rect(tile), local);
-                busy_ns += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - started).count());
-                rays += local.rays;
-                hits += local.hits;
-                for (size_t k = 0; k < by_cell.size(); ++k)
-                    if (local.hits_by_cell_log2[k]) by_cell[k] += local.hits_by_cell_log2[k];
-            }
-        },
-        tbb::simple_partitioner());
+    if (order == TileOrder::sweep) {
+        // One task per thread of the arena, each taking the next tile of one shared counter until
+        // none is left: whichever threads join do all the work, in row-major order.
+        std::atomic<int> next{0};
+        const int workers = std::max(1, std::min(n, tbb::this_task_arena::max_concurrency()));
+        tbb::parallel_for(0, workers, [&](int) {
+            for (int i = next++; i < n; i = next++) run_tile(i);
+        }, tbb::static_partitioner());
+    } else {
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, n, 1),
+            [&](const tbb::blocked_range<int>& range) {
+                for (int i = range.begin(); i < range.end(); ++i) run_tile(i);
+            },
+            tbb::simple_partitioner());
+    }
     RenderStats stats;
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     stats.busy_seconds = double(busy_ns.load()) * 1e-9;

@@ -126,6 +126,27 @@ TEST_F(RendererTest, BusyTimeIsTheTilesOwnAndFitsInsideTheLoop) {
     }
 }
 
+TEST_F(RendererTest, EitherTileOrderOnAnyThreadCountGivesTheSameFrame) {
+    // Issue 12: sweep hands tiles out through one shared counter instead of TBB's split.
+    const Frame reference = Renderer(data_.view(), Placement{}, options_).render(camera_);
+    for (TileOrder order : {TileOrder::split, TileOrder::sweep})
+        for (int threads : {1, 2, 3, 7}) {
+            RenderOptions o = options_;
+            o.tile_order = order;
+            o.threads = threads;
+            const Renderer renderer(data_.view(), Placement{}, o);
+            Frame f = renderer.render(camera_);
+            expect_identical(f, reference);
+            EXPECT_EQ(f.stats.rays, uint64_t(camera_.width) * uint64_t(camera_.height));
+            EXPECT_EQ(f.stats.hits, reference.stats.hits);
+            // A subset of tiles in sweep order touches exactly those tiles.
+            const std::vector<int> some{0, 3, 5};
+            Frame part;
+            renderer.prepare_frame(camera_, part);
+            EXPECT_EQ(renderer.render_tiles(camera_, some, part).rays > 0, true);
+        }
+}
+
 TEST_F(RendererTest, BadCallsAreRefused) {
     const Renderer renderer(data_.view(), Placement{}, options_);
     Frame frame;
