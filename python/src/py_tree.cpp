@@ -3,13 +3,13 @@
 // mapped series it came from. The voxels of an input array are read in place, never copied.
 #include <pybind11/stl.h>
 
-#include <tbb/task_arena.h>
 
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "bindings.h"
+#include "util/shared_arena.h"
 #include "octiso/any_octree.h"
 #include "octiso/build.h"
 #include "octiso/oct_file.h"
@@ -17,14 +17,11 @@
 namespace octiso::python {
 namespace {
 
-/// Runs f in an arena of `threads` threads (0: all cores), without the GIL.
+/// Runs f in the process's arena of `threads` threads (0: all cores; util/shared_arena.h, the
+/// one the Renderer and the builder use too), without the GIL.
 template <class F> auto without_gil(int threads, F&& f) {
     py::gil_scoped_release release;
-    if (threads > 0) {
-        tbb::task_arena arena(threads);
-        return arena.execute(f);
-    }
-    return f();
+    return in_shared_arena(threads, f);
 }
 
 AnyOctree build_from_array(const py::array& array, const py::object& spacing, const py::object& origin,

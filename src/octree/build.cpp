@@ -140,8 +140,8 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
     // 3. Concatenate depth by depth. Depths below k come from `top` alone. The pieces of a depth
     //    are copied in parallel, in batches of 16 pieces or two per thread (whichever is more):
     //    each piece's place and child offset are prefix sums, so the copies are independent
-    //    (issue 12: serial, the copy and the trims were about 0.04 s of a 1.2 s 1-thread build of
-    //    plume 512^3, an Amdahl bound of 67 % at 16 threads; BENCHMARKS.md "Many-core"). Freed piece
+    //    (issue 12: serial, the copy and the trims were 0.044 s of a 1.27 s 1-thread build of
+    //    plume 512^3, an Amdahl bound of 66 % at 16 threads; BENCHMARKS.md "Many-core"). Freed piece
     //    memory is handed back as the copy goes, so peak memory stays near input + output.
     const auto t_concat = std::chrono::steady_clock::now();
     double release_seconds = 0;
