@@ -220,6 +220,9 @@ void write_json(std::ostream& os, const ConvertReport& r, const std::optional<st
         j.key("phases").begin_object().field("read", r.read_seconds).field("prepare", p.prepare).field("pieces", p.pieces).field("pieces_busy", p.pieces_busy)
             .field("top", p.top).field("concatenate", p.concatenate).field("release", p.release)
             .field("write", r.write_seconds).end_object();
+    } else if (r.streamed) {   // out of core: reading and building interleave slab by slab
+        j.key("phases").begin_object().field("slabs", r.slabs_seconds).field("top", r.top_seconds)
+            .field("sections", r.sections_seconds).end_object();
     }
     j.field("mvoxels_per_second", r.mvoxels_per_second());
     j.field("peak_rss_bytes", r.peak_rss_bytes).field("threads", r.threads);

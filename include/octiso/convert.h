@@ -124,6 +124,9 @@ struct ConvertReport {
     /// Zero when streamed, whose slabs are read and built interleaved (build_seconds).
     double read_seconds = 0, write_seconds = 0;
     BuildPhases build_phases;
+    /// Out of core, summed over the steps: the slabs (read and built, interleaved), the top above
+    /// the pieces, the sections streamed into the file. Zero in memory.
+    double slabs_seconds = 0, top_seconds = 0, sections_seconds = 0;
 
     double ratio() const { return input_bytes ? double(file_bytes) / double(input_bytes) : 0.0; }
     double mvoxels_per_second() const {

@@ -171,6 +171,7 @@ ConvertReport convert_streamed(const ConvertSource& source, const std::string& o
         const convert_detail::StreamStepResult res =
             convert_detail::stream_build_step(*s, opt, plan, writer, output, on_layers);
         r.build_seconds += res.build_seconds;
+        r.slabs_seconds += res.slabs_seconds, r.top_seconds += res.top_seconds, r.sections_seconds += res.sections_seconds;
         r.spilled_bytes += res.spilled_bytes;
         if (per_file == 1 || i + 1 == n_steps) r.bytes_read += s->file_bytes_read();
         add_sizes(r.total, res.sizes);

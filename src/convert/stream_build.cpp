@@ -97,11 +97,19 @@ public:
 
     StreamStepResult run(const std::function<void(uint32_t)>& on_layers) {
         const auto t0 = std::chrono::steady_clock::now();
+        const auto since = [](std::chrono::steady_clock::time_point t) {
+            return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+        };
+        StreamStepResult r;
         build_slabs(on_layers);
+        r.slabs_seconds = since(t0);
+        const auto t_top = std::chrono::steady_clock::now();
         Sink<T> top(dmax_);
         const std::vector<uint64_t> order = build_top(top);
-        StreamStepResult r;
+        r.top_seconds = since(t_top);
+        const auto t_sections = std::chrono::steady_clock::now();
         r.sizes = write_sections(top, order);
+        r.sections_seconds = since(t_sections);
         for (const auto& s : spill_) r.spilled_bytes += s->disk_bytes();
         r.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         return r;

@@ -42,6 +42,9 @@ struct StreamStepResult {
     StepSizes sizes;
     double build_seconds = 0;   ///< reading, conditioning, building and writing: the whole step
     uint64_t spilled_bytes = 0; ///< node bytes that went to temporary files
+    /// Its phases (issue 12): the slabs (read, conditioned and built into pieces, interleaved),
+    /// the top above the pieces, and the sections streamed into the writer.
+    double slabs_seconds = 0, top_seconds = 0, sections_seconds = 0;
 };
 
 /// Builds the step `stream` holds (its cursor at layer 0) under `plan` and writes its sections

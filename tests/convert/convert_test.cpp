@@ -84,6 +84,10 @@ void expect_totals_are_the_sums(const ConvertReport& r) {
         EXPECT_GT(r.write_seconds, 0.0);
         EXPECT_LE(r.read_seconds + r.build_seconds + r.write_seconds, r.total_seconds);
     }
+    if (r.streamed) {   // out of core: the step's phases add up to its build time
+        EXPECT_GT(r.slabs_seconds, 0.0);
+        EXPECT_LE(r.slabs_seconds + r.top_seconds + r.sections_seconds, r.build_seconds);
+    }
 }
 
 TEST(Convert, SyntheticSeriesDecodesStepByStepAndReportsItsSums) {
@@ -139,6 +143,14 @@ TEST(Convert, PatternAndListOfRawFilesGiveTheSameFile) {
     std::ifstream fa(dir.file("a.oct"), std::ios::binary), fb(dir.file("b.oct"), std::ios::binary);
     const std::string bytes_a((std::istreambuf_iterator<char>(fa)), {}), bytes_b((std::istreambuf_iterator<char>(fb)), {});
     EXPECT_TRUE(bytes_a == bytes_b) << "the same steps from a pattern or a list";
+    // Out of core: the same file, and its own phases (slabs, top, sections) add up.
+    MemoryOptions streaming;
+    streaming.force_streaming = true;
+    const ConvertReport streamed = convert(pattern, dir.file("c.oct"), opt, streaming);
+    EXPECT_TRUE(streamed.streamed);
+    expect_totals_are_the_sums(streamed);
+    std::ifstream fc(dir.file("c.oct"), std::ios::binary);
+    EXPECT_TRUE(std::string((std::istreambuf_iterator<char>(fc)), {}) == bytes_a) << "out of core, the same bytes";
     const OctFile f = OctFile::open(dir.file("a.oct"));
     EXPECT_EQ(f.info().iso_range, opt.iso_range);
 
