@@ -7,22 +7,26 @@ import matplotlib.pyplot as plt
 
 def plot(data, out_png):
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.5))
-    widths = sorted({m["width"] for m in data["measured"]})
-    for w in widths:
-        rows = sorted((m for m in data["measured"] if m["width"] == w), key=lambda m: m["threads"])
+    # One line per image size and tile order (issue 12: --tile-order both measures split and sweep).
+    groups = sorted({(m["width"], m.get("tile_order", "split")) for m in data["measured"]})
+    several_orders = len({order for _, order in groups}) > 1
+    for w, order in groups:
+        rows = sorted((m for m in data["measured"] if m["width"] == w and m.get("tile_order", "split") == order),
+                      key=lambda m: m["threads"])
         one = next(m["median_seconds"] for m in rows if m["threads"] == 1)
         p = [m["threads"] for m in rows]
         eff = [100.0 * one / m["median_seconds"] / m["threads"] for m in rows]
-        left.plot(p, eff, "o-", label=f"{w}^2 wall")
+        tag = f"{w}^2 {order}" if several_orders else f"{w}^2"
+        left.plot(p, eff, "o-", label=f"{tag} wall")
         if all(m.get("busy_seconds") for m in rows):
             med = lambda v: sorted(v)[len(v) // 2]
             left.plot(p, [100.0 * med(m["busy_seconds"]) / (m["threads"] * m["median_seconds"]) for m in rows], "^:",
-                      label=f"{w}^2 tile-loop utilisation")
+                      label=f"{tag} tile-loop utilisation")
         if all(m.get("cpu_seconds") for m in rows):
             med = lambda v: sorted(v)[len(v) // 2]
             one_cpu = med(next(m["cpu_seconds"] for m in rows if m["threads"] == 1))
             left.plot(p, [100.0 * one_cpu / med(m["cpu_seconds"]) for m in rows], "s--",
-                      label=f"{w}^2 CPU work (1 thread / P threads)")
+                      label=f"{tag} CPU work (1 thread / P threads)")
     builds = sorted(data.get("build", []), key=lambda b: b["threads"])
     if builds:
         one = next(b["median_seconds"] for b in builds if b["threads"] == 1)
