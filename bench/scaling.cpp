@@ -34,6 +34,9 @@
 #include "render/traverse.h"
 
 namespace octiso::bench {
+
+double avx2_fma_chains(int iterations);   // ceiling_avx2.cpp (built for AVX2 + FMA)
+
 namespace {
 
 const char* const kScalingUsage =
@@ -93,6 +96,24 @@ double compute_bound_seconds(int threads, int repeats) {
         });
         s.push_back(seconds_since(t0));
         if (sink.load() == -1.0) std::cerr << "";   // keep the loop observable
+    }
+    std::sort(s.begin(), s.end());
+    return s[s.size() / 2];
+}
+
+/// The same ceiling with 256-bit FMA chains (the renderer's kernel is AVX2): wall seconds of a
+/// fixed amount per thread on `threads` threads at once, median of `repeats`.
+double avx2_bound_seconds(int threads, int repeats) {
+    std::vector<double> s;
+    for (int r = 0; r < repeats; ++r) {
+        tbb::task_arena arena(threads);
+        std::atomic<double> sink{0};
+        const auto t0 = std::chrono::steady_clock::now();
+        arena.execute([&] {
+            tbb::parallel_for(0, threads, [&](int) { sink = sink + avx2_fma_chains(20'000'000); }, tbb::static_partitioner());
+        });
+        s.push_back(seconds_since(t0));
+        if (sink.load() == -1.0) std::cerr << "";
     }
     std::sort(s.begin(), s.end());
     return s[s.size() / 2];
@@ -287,6 +308,14 @@ int run_scaling(cli::Args& args) {
         for (int p : thread_counts)
             ceiling_speedup[size_t(p - 1)] = p == 1 ? 1.0 : double(p) * one / compute_bound_seconds(p, ceiling_repeats);
     }
+    // The same with 256-bit FMA work, where the CPU has AVX2 (reported beside, not in the model).
+    std::vector<double> avx2_ceiling_speedup(size_t(thread_counts.back()), 0.0);
+    if (cpu_has_avx2()) {
+        const int ceiling_repeats = quick ? 1 : 3;
+        const double one = avx2_bound_seconds(1, ceiling_repeats);
+        for (int p : thread_counts)
+            avx2_ceiling_speedup[size_t(p - 1)] = p == 1 ? 1.0 : double(p) * one / avx2_bound_seconds(p, ceiling_repeats);
+    }
     // The nearest measured ceiling at or below P (the model's input where P was not measured).
     const auto ceiling_at = [&](int p) {
         for (int q = std::min(p, int(ceiling_speedup.size())); q >= 1; --q)
@@ -444,10 +473,12 @@ int run_scaling(cli::Args& args) {
         std::cout << "\n";
         bt.print_markdown(std::cout);
     }
-    Table ct({"threads", "compute-bound speedup (measured ceiling)", "ceiling eff."});
+    Table ct({"threads", "compute-bound speedup (measured ceiling)", "ceiling eff.", "AVX2 FMA ceiling eff."});
     for (int p : thread_counts)
-        ct.add({std::to_string(p), fmt(ceiling_speedup[size_t(p - 1)], 3), fmt(100.0 * ceiling_speedup[size_t(p - 1)] / p, 1) + " %"});
-    std::cout << "\nmachine ceiling (measured): a compute-bound loop of fixed length per thread\n";
+        ct.add({std::to_string(p), fmt(ceiling_speedup[size_t(p - 1)], 3), fmt(100.0 * ceiling_speedup[size_t(p - 1)] / p, 1) + " %",
+                avx2_ceiling_speedup[size_t(p - 1)] > 0 ? fmt(100.0 * avx2_ceiling_speedup[size_t(p - 1)] / p, 1) + " %" : "-"});
+    std::cout << "\nmachine ceiling (measured): a compute-bound loop of fixed length per thread (scalar; and 256-bit "
+                 "FMA chains where the CPU has AVX2: clocks may drop under it on many cores)\n";
     ct.print(std::cout);
     std::cout << "\n";
     ct.print_markdown(std::cout);
@@ -480,6 +511,7 @@ int run_scaling(cli::Args& args) {
         j.field("iso", iso).field("repeats", repeats).field("loadavg", load);
         j.key("threads").array(thread_counts);
         j.key("ceiling_speedup").array(ceiling_speedup);   // measured, index = threads - 1 (0: not measured)
+        j.key("avx2_ceiling_speedup").array(avx2_ceiling_speedup);   // the same with 256-bit FMA chains (0: no AVX2)
         j.key("measured").begin_array();
         for (const auto& m : measured) {
             j.begin_object();
