@@ -291,6 +291,8 @@ int run_scaling(cli::Args& args) {
     else if (name == "plume" || name == "mixing") volume = synthetic_step(name, Dims{n, n, n}, 0);
 #if OCTISO_SCALING_READS_FILES
     else if (name == "mri") volume = open_volume(mri_flag ? *mri_flag : "/usr/share/mricron/templates/ch2.nii.gz", RawOptions{});
+#else
+    else if (name == "mri") throw Error("--dataset", "mri is read through VTK, which octiso-probe leaves out: convert it and pass the .oct");
 #endif
     else throw Error("--dataset", "expected plume, mixing, mri or a .oct file, found '" + name + "'");
     if (!volume && mri_flag) throw Error("--mri", "only with --dataset mri");
