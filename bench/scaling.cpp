@@ -75,25 +75,16 @@ double static_makespan(const std::vector<double>& cost, int workers) {
     return makespan;
 }
 
-/// The machine's ceiling: wall seconds of a compute-bound loop (8 independent FMA chains, no memory
-/// traffic) of fixed length per thread, run on `threads` threads at once in a task arena; the
-/// ceiling speedup at P is P * t(1) / t(P). Median of `repeats` runs.
-double compute_bound_seconds(int threads, int repeats) {
+/// Wall seconds of `work()` (which returns a value, kept observable) run once on each of `threads`
+/// threads at once in a task arena; median of `repeats` runs. The ceiling speedup at P is
+/// P * t(1) / t(P).
+template <class Work> double ceiling_seconds(int threads, int repeats, Work&& work) {
     std::vector<double> s;
     for (int r = 0; r < repeats; ++r) {
         tbb::task_arena arena(threads);
         std::atomic<double> sink{0};
         const auto t0 = std::chrono::steady_clock::now();
-        arena.execute([&] {
-            tbb::parallel_for(0, threads, [&](int) {
-                double x[8] = {1, 2, 3, 4, 5, 6, 7, 8};
-                for (int i = 0; i < 20'000'000; ++i)
-                    for (double& v : x) v = v * 0.999999 + 1e-7;
-                double sum = 0;
-                for (double v : x) sum += v;
-                sink = sink + sum;
-            }, tbb::static_partitioner());
-        });
+        arena.execute([&] { tbb::parallel_for(0, threads, [&](int) { sink = sink + work(); }, tbb::static_partitioner()); });
         s.push_back(seconds_since(t0));
         if (sink.load() == -1.0) std::cerr << "";   // keep the loop observable
     }
@@ -101,22 +92,22 @@ double compute_bound_seconds(int threads, int repeats) {
     return s[s.size() / 2];
 }
 
-/// The same ceiling with 256-bit FMA chains (the renderer's kernel is AVX2): wall seconds of a
-/// fixed amount per thread on `threads` threads at once, median of `repeats`.
+/// The machine's ceiling: a compute-bound loop (8 independent scalar multiply-add chains, no
+/// memory traffic) of fixed length per thread.
+double compute_bound_seconds(int threads, int repeats) {
+    return ceiling_seconds(threads, repeats, [] {
+        double x[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+        for (int i = 0; i < 20'000'000; ++i)
+            for (double& v : x) v = v * 0.999999 + 1e-7;
+        double sum = 0;
+        for (double v : x) sum += v;
+        return sum;
+    });
+}
+
+/// The same ceiling with 256-bit FMA chains (the renderer's kernel is AVX2; AVX2 CPUs only).
 double avx2_bound_seconds(int threads, int repeats) {
-    std::vector<double> s;
-    for (int r = 0; r < repeats; ++r) {
-        tbb::task_arena arena(threads);
-        std::atomic<double> sink{0};
-        const auto t0 = std::chrono::steady_clock::now();
-        arena.execute([&] {
-            tbb::parallel_for(0, threads, [&](int) { sink = sink + avx2_fma_chains(20'000'000); }, tbb::static_partitioner());
-        });
-        s.push_back(seconds_since(t0));
-        if (sink.load() == -1.0) std::cerr << "";
-    }
-    std::sort(s.begin(), s.end());
-    return s[s.size() / 2];
+    return ceiling_seconds(threads, repeats, [] { return avx2_fma_chains(20'000'000); });
 }
 
 /// CPU seconds of the whole process (all threads, spinning workers included).
