@@ -153,13 +153,6 @@ struct BuildRow {
     }
 };
 
-/// The whole-call seconds of the first 1-thread row of image `width` (the first order's).
-std::vector<double> rows_of_width_one_call(const std::vector<Measured>& measured, int width) {
-    for (const Measured& m : measured)
-        if (m.width == width && m.threads == 1) return m.call_seconds;
-    return {};
-}
-
 const char* order_name(TileOrder order) { return order == TileOrder::sweep ? "sweep" : "split"; }
 
 /// Amdahl's bound at P threads for a run whose `serial` seconds of `total` cannot overlap.
@@ -418,16 +411,16 @@ int run_scaling(cli::Args& args) {
     Table mt({"image", "tiles to threads", "threads", "frames/s", "Mrays/s", "speedup", "efficiency", "utilisation", "busy / busy(1)",
               "CPU s/frame", "CPU-work eff.", "render() setup s", "model eff.", "measured - model"});
     for (const auto& m : measured) {
-        double one = 0, one_cpu = 0, one_busy = 0;
+        double one = 0, one_cpu = 0, one_busy = 0, one_call = 0;
         for (const auto& o : measured)   // against 1 thread of the first order (split, where measured)
             if (o.width == m.width && o.threads == 1 && o.order == orders.front())
-                one = o.median(), one_cpu = Measured::median_of(o.cpu_seconds), one_busy = Measured::median_of(o.busy_seconds);
+                one = o.median(), one_cpu = Measured::median_of(o.cpu_seconds), one_busy = Measured::median_of(o.busy_seconds),
+                one_call = Measured::median_of(o.call_seconds);
         const double speedup = one / m.median();
         const double cpu = Measured::median_of(m.cpu_seconds), busy = Measured::median_of(m.busy_seconds);
         const double model_eff = model_at(m.width, m.threads) / m.threads;
         // The wall-clock speed-up counts the whole render() call, as the model does (serial set-up included).
-        const double call_speedup = Measured::median_of(rows_of_width_one_call(measured, m.width)) /
-                                    Measured::median_of(m.call_seconds);
+        const double call_speedup = one_call / Measured::median_of(m.call_seconds);
         mt.add({std::to_string(m.width) + "^2", order_name(m.order), std::to_string(m.threads), fmt(1.0 / m.median(), 2),
                 fmt(double(m.width) * m.width / m.median() * 1e-6, 2), fmt(speedup, 3), fmt(100.0 * speedup / m.threads, 1) + " %",
                 fmt(100.0 * busy / (m.threads * m.median()), 1) + " %", fmt(one_busy > 0 ? busy / one_busy : 0.0, 3),
