@@ -249,15 +249,17 @@ private:
         return false;
     }
 
-    /// The cap (block 0) and its forward neighbour blocks (2x2x2 at co + 2 * (r>>2&1, r>>1&1,
-    /// r&1), r = 1..7): each neighbour is a cap or lies inside one scalar leaf, located by
-    /// neighbour finding on first use and then read directly. One per cap visit; a packet shares
-    /// it between its lanes.
+    /// The corner lattice of one cap: the 3x3x3 voxels that its 8 cells' corners are, at
+    /// lattice[9 x + 3 y + z] (x, y, z = 0..2 from the cap's origin), filled block by block on
+    /// first use and then read directly. Block 0 is the cap itself; block r = 1..7 (octant bits) is
+    /// its forward neighbour 2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), a cap or part of one scalar
+    /// leaf, located by neighbour finding; only its voxels on the lattice are decoded (4 of a face
+    /// block, 2 of an edge block, 1 of the corner block). One per cap visit; a packet shares it
+    /// between its lanes, so each voxel is decoded once per packet instead of once per corner per
+    /// lane (BENCHMARKS.md, packet section: the lattice A/B).
     struct CapBlocks {
-        CapRef<T> cap[8];     ///< blocks in a cap, read voxel by voxel (decoding each block whole: 0.82 x on Marschner-Lobb, BENCHMARKS issue 19)
-        T value[8];           ///< blocks inside a scalar leaf
-        unsigned located = 1;   ///< block 0 is the cap itself
-        unsigned in_cap = 1;
+        double lattice[27];   ///< unset until its block's bit is in `ready`
+        unsigned ready = 0;   ///< bit r: block r's lattice voxels are in place
     };
 
     /// One packet of rays sharing their direction signs: per lane its walk, its piece [t0, t1) of
@@ -345,13 +347,40 @@ private:
         return active;
     }
 
+    /// Blocks whose voxels a cell of octant `oct` of a cap reads: every block r with r & ~oct == 0.
+    static constexpr unsigned blocks_of_octant(int oct) {
+        unsigned m = 0;
+        for (int r = 0; r < 8; ++r)
+            if ((r & ~oct) == 0) m |= 1u << r;
+        return m;
+    }
+
+    /// Puts the lattice voxels of the blocks in `missing` into `blocks` (CapBlocks).
+    [[gnu::noinline]] void fill_cap_blocks(CapBlocks& blocks, unsigned missing, const CapRef<T>& ref, const Coord& co,
+                                         const uint32_t* trace) const {
+        const int parent_depth = tree_.dmax() - 2;
+        for (unsigned m = missing; m; m &= m - 1) {
+            const int r = std::countr_zero(m);
+            LeafRef<T> found{T{}, true, ref, 0};
+            if (r != 0) {
+                // Outside this cap, so the climb starts at its parent (octree.h).
+                const Coord b{co.x + ((r & 4) ? 2u : 0u), co.y + ((r & 2) ? 2u : 0u), co.z + ((r & 1) ? 2u : 0u)};
+                found = tree_.neighbour_locate(co, b, parent_depth, trace);
+            }
+            // The block's lattice voxels: 2 on the axes of r (its local 0), 0 or 1 on the others.
+            for (int local = 0; local < 8; ++local) {
+                if (local & r) continue;
+                const int x = (r & 4) ? 2 : (local >> 2) & 1, y = (r & 2) ? 2 : (local >> 1) & 1, z = (r & 1) ? 2 : local & 1;
+                blocks.lattice[9 * x + 3 * y + z] = found.in_cap ? double(found.cap.voxel(local)) : double(found.value);
+            }
+        }
+        blocks.ready |= missing;
+    }
+
     bool cap(RayState& w, const uint32_t* trace, const CapRef<T>& ref, const Coord& co, double t0, double t1,
              CapBlocks& blocks) const {
         const int parent_depth = tree_.dmax() - 2;
         if constexpr (Recorder::kOn) recorder_.enter_cap(parent_depth + 1, trace[parent_depth], co, t0, t1);
-        unsigned& located = blocks.located;
-        unsigned& in_cap = blocks.in_cap;
-        blocks.cap[0] = ref;
         // Sort-last (set_owned_cells): decided once per cap.
         const bool cap_on_ghost = restricted_ && ghost_ && co.x + 2 == owned_.hi[0];
         // Forced inline: once the packed caps' decode made it larger, GCC called it per cell
@@ -361,26 +390,21 @@ private:
                 corners_.gather(v, corner);
                 return;
             }
-            const int oct = int(((v.x - co.x) << 2) | ((v.y - co.y) << 1) | (v.z - co.z));
+            const uint32_t x = v.x - co.x, y = v.y - co.y, z = v.z - co.z;
+            static constexpr unsigned kNeeds[8] = {blocks_of_octant(0), blocks_of_octant(1), blocks_of_octant(2), blocks_of_octant(3),
+                                                   blocks_of_octant(4), blocks_of_octant(5), blocks_of_octant(6), blocks_of_octant(7)};
             const bool on_ghost = cap_on_ghost && v.x + 1 == owned_.hi[0];
-            for (int k = 0; k < 8; ++k) {
-                if (on_ghost && (k & 1)) [[unlikely]] {
-                    corner[k] = ghost_value(v, k);
-                    continue;
-                }
-                const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
-                const int r = oct & dir;                                         // which block holds the corner
-                if (!((located >> r) & 1u)) {
-                    // Outside this cap, so the climb starts at its parent (octree.h).
-                    const Coord b{co.x + ((r & 4) ? 2u : 0u), co.y + ((r & 2) ? 2u : 0u), co.z + ((r & 1) ? 2u : 0u)};
-                    const LeafRef<T> found = tree_.neighbour_locate(co, b, parent_depth, trace);
-                    if (found.in_cap) blocks.cap[r] = found.cap;
-                    else blocks.value[r] = found.value;
-                    in_cap |= unsigned(found.in_cap) << r;
-                    located |= 1u << r;
-                }
-                corner[k] = ((in_cap >> r) & 1u) ? double(blocks.cap[r].voxel((oct | dir) & ~r)) : double(blocks.value[r]);
+            // On the ghost plane the +x corners come from it, not from the blocks beyond the box.
+            const unsigned need = kNeeds[(x << 2) | (y << 1) | z] & (on_ghost ? 0x0Fu : 0xFFu);
+            if ((blocks.ready & need) != need) fill_cap_blocks(blocks, need & ~blocks.ready, ref, co, trace);
+            // Corner i + 2j + 4k of the cell is lattice point (x + i, y + j, z + k).
+            const double* at = blocks.lattice + (9 * x + 3 * y + z);
+            static constexpr int kOffset[8] = {0, 9, 3, 12, 1, 10, 4, 13};
+            if (on_ghost) [[unlikely]] {
+                for (int k = 0; k < 8; ++k) corner[k] = (k & 1) ? ghost_value(v, k) : at[kOffset[k]];
+                return;
             }
+            for (int k = 0; k < 8; ++k) corner[k] = at[kOffset[k]];
         });
     }
 

@@ -1,0 +1,86 @@
+#!/usr/bin/python3
+"""A change of the tracer measured alone: two builds of octiso-render (A, the one before the change,
+e.g. a worktree of the previous commit; B, this one) render the same orbit of each file, PAIRS times,
+A and B interleaved and the order flipped every pair so that drift on a shared machine hits both
+alike. Per file it prints the minimum and median over the runs of the mean tile-loop time per frame
+(`phases.trace` of --json), B / A, and whether the depth and normal images of both builds are the
+same pixels (idiff -fail 0: a change meant to keep the image must).
+
+    scripts/build_ab.py --a /work/wt-old/build/octiso-render [--b build/octiso-render] [--pairs 5]
+                        [--threads 1] [--size 512x512] [--orbit 8] [--flags '--no-embree']
+                        [--results DIR] [--tag NAME] FILE.oct@ISO [FILE.oct@ISO ...]
+
+--results DIR writes build_ab[_NAME].json there (default: a temporary folder, printed). Used for
+BENCHMARKS.md, "Packet traversal and ISA kernels" (the cap corner lattice)."""
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import tempfile
+
+
+def render(binary, path, iso, a, outdir, tag):
+    depth = os.path.join(outdir, f"{tag}_depth_%d.exr")
+    normal = os.path.join(outdir, f"{tag}_normal_%d.exr")
+    cmd = [binary, path, "--iso", iso, "--depth", depth, "--normal", normal, "--orbit", str(a.orbit),
+           "--threads", str(a.threads), "--size", a.size, "--json"] + a.flags.split()
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    frames = json.loads(out)["frames"]
+    return sum(f["phases"]["trace"] for f in frames) / len(frames)
+
+
+def same_pixels(outdir, orbit):
+    for kind in ("depth", "normal"):
+        for i in range(orbit):
+            pa, pb = (os.path.join(outdir, f"{t}_{kind}_{i}.exr") for t in ("A", "B"))
+            if subprocess.run(["idiff", "-fail", "0", "-warn", "0", pa, pb], capture_output=True).returncode != 0:
+                return False
+    return True
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("datasets", nargs="+", help="FILE.oct@ISO")
+    p.add_argument("--a", required=True, help="octiso-render before the change")
+    p.add_argument("--b", default="build/octiso-render", help="octiso-render with the change")
+    p.add_argument("--pairs", type=int, default=5)
+    p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--size", default="512x512")
+    p.add_argument("--orbit", type=int, default=8)
+    p.add_argument("--flags", default="--no-embree")
+    p.add_argument("--results")
+    p.add_argument("--tag", default="", help="the JSON is build_ab_TAG.json")
+    a = p.parse_args()
+    rows = []
+    print(f"| file | iso | A min / median ms | B min / median ms | B / A (min) | B / A (median) | same pixels |")
+    print("|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as outdir:
+        for spec in a.datasets:
+            path, iso = spec.rsplit("@", 1)
+            t = {"A": [], "B": []}
+            for pair in range(a.pairs):
+                order = ("A", "B") if pair % 2 == 0 else ("B", "A")
+                for tag in order:
+                    t[tag].append(render(a.a if tag == "A" else a.b, path, iso, a, outdir, tag))
+            same = same_pixels(outdir, a.orbit)
+            row = {"file": path, "iso": float(iso), "a_seconds": t["A"], "b_seconds": t["B"],
+                   "b_over_a_min": min(t["B"]) / min(t["A"]),
+                   "b_over_a_median": statistics.median(t["B"]) / statistics.median(t["A"]), "same_pixels": same}
+            rows.append(row)
+            print(f"| {os.path.basename(path)} | {iso} | {1e3 * min(t['A']):.1f} / {1e3 * statistics.median(t['A']):.1f} | "
+                  f"{1e3 * min(t['B']):.1f} / {1e3 * statistics.median(t['B']):.1f} | {row['b_over_a_min']:.3f} | "
+                  f"{row['b_over_a_median']:.3f} | {'yes' if same else 'NO'} |")
+    results = a.results or tempfile.mkdtemp(prefix="octiso_build_ab_")
+    os.makedirs(results, exist_ok=True)
+    out = os.path.join(results, f"build_ab_{a.tag}.json" if a.tag else "build_ab.json")
+    with open(out, "w") as f:
+        json.dump({"a": a.a, "b": a.b, "pairs": a.pairs, "threads": a.threads, "size": a.size, "orbit": a.orbit,
+                   "flags": a.flags, "machine": platform.processor() or platform.machine(), "rows": rows}, f, indent=1)
+    print(f"JSON: {out}")
+    return 0 if all(r["same_pixels"] for r in rows) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
