@@ -10,10 +10,12 @@
 // Caps and scalar leaves: a short DDA over their cells. A scalar leaf's inner cells have all 8
 // corners equal to the leaf value, so unless an isovalue equals it only the shell of cells at its
 // +x/+y/+z faces (whose forward corners lie in neighbours) is walked.
-// Corners: inside a cap, a forward neighbour in the same cap is a direct read (octant & dir == 0),
-// otherwise neighbour finding climbs the parent trace this traversal keeps (App. B.2); each of the
-// 7 forward neighbour blocks of a cap is located once per cap visit and then read directly
-// (measured by `octiso-bench grid`: +3-5 % frames/s on octree data, BENCHMARKS.md, grid section).
+// Corners: a cap's cells read their corners from its 3x3x3 corner lattice (CapBlocks): the cap's
+// own voxels, and those of its 7 forward neighbour blocks, each located once per cap visit by
+// neighbour finding on the parent trace this traversal keeps (App. B.2) and decoded into the
+// lattice when a cell first needs it (locating each block once: +3-5 % frames/s on octree data,
+// `octiso-bench grid`; the lattice shared by a packet's lanes: 0.84-1.00 x the frame time,
+// scripts/build_ab.py; BENCHMARKS.md, grid and packet sections).
 // The corner source is a policy only for the grid benchmark's "octree over array data" variant
 // (Knoll 2006 Table 3); with the default, OctreeCornerSource, the policy costs nothing.
 // The recorder is a policy only for `--debug-pixel` (octiso/debug_trace.h): with the default,
