@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <type_traits>
 
@@ -40,6 +41,16 @@
 
 namespace octiso {
 OCTISO_ISA_BEGIN
+
+#if defined(__AVX2__)
+/// Four doubles (and their compare masks) for the AVX2 kernel's packet split (PacketSplit): GCC
+/// vector extensions, one AVX2 register each. The operations are the scalar IEEE ones lane by
+/// lane (no FMA: -ffp-contract=off), so the results are the scalar ones bit for bit.
+using V4d = double __attribute__((vector_size(32)));
+using V4l = long long __attribute__((vector_size(32)));
+OCTISO_ALWAYS_INLINE void load4(V4d& v, const double* p) { std::memcpy(&v, p, sizeof v); }
+OCTISO_ALWAYS_INLINE void store4(double* p, const V4d& v) { std::memcpy(p, &v, sizeof v); }
+#endif
 
 /// The default corner source: the octree itself (in-cap reads and neighbour finding). Any other
 /// Corners type provides `void gather(Coord cell, double corner[8]) const` and replaces every
@@ -113,14 +124,20 @@ public:
         OCTISO_DCHECK(count >= 0 && count <= kMaxPacket, "packet of ", count);
         Packet p;
         unsigned by_flip[8] = {};
-        for (int k = 0; k < count; ++k) {
-            if (valid && !valid[k]) continue;
+        for (int k = 0; k < kMaxPacket; ++k) {
+            p.t0[k] = std::numeric_limits<double>::infinity(), p.t1[k] = -std::numeric_limits<double>::infinity();
+            if (k >= count || (valid && !valid[k])) continue;
             const BoxClip clip = p.lane[k].start(scene_, rays[k], want_normal);
             if (clip.empty()) continue;
             p.t0[k] = clip.t_in, p.t1[k] = clip.t_out;
             const auto& dir = p.lane[k].ray.dir;
             by_flip[(dir[0] < 0 ? 4 : 0) | (dir[1] < 0 ? 2 : 0) | (dir[2] < 0 ? 1 : 0)] |= 1u << k;
         }
+        for (int a = 0; a < 3; ++a)
+            for (int k = 0; k < kMaxPacket; ++k) {
+                const IndexRay& r = p.lane[k].ray;
+                p.origin[a][k] = r.origin[a], p.dir[a][k] = r.dir[a], p.inv_dir[a][k] = r.inv_dir[a];
+            }
         for (int flip = 0; flip < 8; ++flip) {
             const unsigned lanes = by_flip[flip];
             if (!lanes) continue;
@@ -268,9 +285,104 @@ private:
     /// the data box; the parent trace is the packet's (all its lanes are in the same nodes).
     struct Packet {
         Walk lane[kMaxPacket];
-        double t0[kMaxPacket], t1[kMaxPacket];
+        // Every lane's entry is set, unused ones to an empty piece: packet_node reads all of them.
+        alignas(32) double t0[kMaxPacket], t1[kMaxPacket];
+        /// The lanes' index rays by axis (lane k at [a][k]; unused lanes zero) for packet_node's
+        /// four-lane arithmetic.
+        alignas(32) double origin[3][kMaxPacket], dir[3][kMaxPacket], inv_dir[3][kMaxPacket];
         uint32_t trace[kMaxDepth];
     };
+
+#if defined(__AVX2__)
+    /// The lanes' pieces of a node's children, four lanes at a time (the AVX2 kernel): per lane its
+    /// mid-plane times, the side of each plane it starts on, and whether it crosses the plane
+    /// inside [t0, t1). Its piece of child c is then [max(t0, times of the planes between its
+    /// start child and c), min(t1, times of the other planes it crosses)): the running max and the
+    /// next crossing of node()'s walk (for_each_child_piece), the same numbers by the same
+    /// operations, so the same pieces bit for bit; a child it does not reach gets an empty piece.
+    /// Computed only for the children that survive the cull: 0.77-0.99 x the frame time of the
+    /// per-lane walk below (BENCHMARKS.md, packet section, the A/B). The portable kernel keeps the
+    /// walk: there GCC lowers these 4-wide vectors to SSE halves so badly that frames took
+    /// 1.7-2.0 x as long, and a scalar version of this split lost to the walk as well.
+    struct PacketSplit {
+        static constexpr int kHalves = kMaxPacket / 4;
+        V4d tm[3][kHalves];
+        V4l up[3][kHalves], crossed[3][kHalves];
+        const double* t0 = nullptr;
+        const double* t1 = nullptr;
+        alignas(32) double lo_[kMaxPacket], hi_[kMaxPacket];
+
+        void split(const OctreeTracer& tr, const Packet& p, const Coord& o, uint32_t half, unsigned /*active*/,
+                   const double* t0_in, const double* t1_in) {
+            t0 = t0_in, t1 = t1_in;
+            const uint32_t origin[3] = {o.x, o.y, o.z};
+            const double inf_ = std::numeric_limits<double>::infinity();
+            const V4d zero{}, inf{inf_, inf_, inf_, inf_};
+            for (int h = 0; h < kHalves; ++h) {
+                V4d T0, T1;
+                load4(T0, t0 + 4 * h), load4(T1, t1 + 4 * h);
+                for (int a = 0; a < 3; ++a) {
+                    V4d O, D, I;
+                    load4(O, p.origin[a] + 4 * h), load4(D, p.dir[a] + 4 * h), load4(I, p.inv_dir[a] + 4 * h);
+                    const double mid = double(origin[a] + half);
+                    const V4d M{mid, mid, mid, mid};
+                    const V4d t = D == zero ? inf : (M - O) * I;   // IndexRay::plane_t
+                    tm[a][h] = t;
+                    // upper_at: by time where the ray moves along the axis, else by position.
+                    const V4l top_face_rule = mid < tr.scene_.box_hi[a] ? V4l{} - 1 : V4l{};
+                    const V4l in_plane_up = (O > M) | ((O == M) & top_face_rule);
+                    up[a][h] = D > zero ? V4l(t <= T0) : D < zero ? V4l(T0 < t) : in_plane_up;
+                    crossed[a][h] = (t > T0) & (t < T1);
+                }
+            }
+        }
+        /// The lanes of `active` that enter child c; their pieces are then at lo(c), hi(c).
+        unsigned enter(unsigned c, unsigned active) {
+            unsigned entered = 0;
+            for (int h = 0; h < kHalves; ++h) {
+                V4d lo, hi;
+                load4(lo, t0 + 4 * h), load4(hi, t1 + 4 * h);
+                V4l ok = V4l{} - 1;
+                for (int a = 0; a < 3; ++a) {
+                    const V4l side = (c & (4u >> a)) ? V4l{} - 1 : V4l{};
+                    const V4l between = up[a][h] ^ side;
+                    const V4d t = tm[a][h];
+                    lo = between ? (lo < t ? t : lo) : lo;                      // std::max(lo, t)
+                    hi = (~between & crossed[a][h]) ? (t < hi ? t : hi) : hi;   // std::min(hi, t)
+                    ok &= ~between | crossed[a][h];
+                }
+                ok &= hi > lo;
+                store4(lo_ + 4 * h, lo), store4(hi_ + 4 * h, hi);
+                for (int j = 0; j < 4; ++j) entered |= unsigned(ok[j] & 1) << (4 * h + j);
+            }
+            return entered & active;
+        }
+        const double* lo(unsigned) const { return lo_; }
+        const double* hi(unsigned) const { return hi_; }
+    };
+#else
+    /// The lanes' pieces of a node's children, lane by lane (the portable kernel): each lane's
+    /// own mid-plane walk, node()'s for_each_child_piece, so every piece is the single-ray one.
+    struct PacketSplit {
+        unsigned lanes_in[8] = {};
+        double lo_[8][kMaxPacket], hi_[8][kMaxPacket];
+
+        void split(const OctreeTracer& tr, const Packet& p, const Coord& o, uint32_t half, unsigned active,
+                   const double* t0, const double* t1) {
+            for (unsigned m = active; m; m &= m - 1) {
+                const int k = std::countr_zero(m);
+                tr.for_each_child_piece(p.lane[k].ray, o, half, t0[k], t1[k], [&](int c, double lo, double hi) {
+                    lanes_in[c] |= 1u << k;
+                    lo_[c][k] = lo, hi_[c][k] = hi;
+                    return false;
+                });
+            }
+        }
+        unsigned enter(unsigned c, unsigned active) const { return lanes_in[c] & active; }
+        const double* lo(unsigned c) const { return lo_[c]; }
+        const double* hi(unsigned c) const { return hi_[c]; }
+    };
+#endif
 
     /// Knoll, Wald, Hansen 2009 for primary rays, exact: the lanes in `active` (all with the
     /// direction signs `flip`, bit 4>>a set where dir[a] < 0) traverse node (d, index) together.
@@ -289,22 +401,15 @@ private:
         p.trace[d] = index;
         const InteriorNode<T>& n = tree_.node(d, index);
         const uint32_t half = tree_.child_bit(d);
-        // Per lane, the children it crosses and its piece of each, by node()'s own walk
-        // (for_each_child_piece); lanes_in[c]: who enters child c.
-        unsigned lanes_in[8] = {};
-        double c0[8][kMaxPacket], c1[8][kMaxPacket];
-        for (unsigned m = active; m; m &= m - 1) {
-            const int k = std::countr_zero(m);
-            for_each_child_piece(p.lane[k].ray, o, half, t0[k], t1[k], [&](int c, double lo, double hi) {
-                lanes_in[c] |= 1u << k;
-                c0[c][k] = lo, c1[c][k] = hi;
-                return false;
-            });
-        }
+        PacketSplit split;
+        split.split(*this, p, o, half, active, t0, t1);
         for (int i = 0; i < 8 && active; ++i) {
             const unsigned c = unsigned(i ^ flip);
-            const unsigned entered = lanes_in[c] & active;
-            if (!entered || !n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
+            if (!n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
+            const unsigned entered = split.enter(c, active);
+            if (!entered) continue;
+            const double* c0 = split.lo(c);
+            const double* c1 = split.hi(c);
             const Coord co = child_origin_of(o, int(c), half);
             if (restricted_ && !overlaps_owned(co, half)) continue;
             unsigned hit = 0;
@@ -315,7 +420,7 @@ private:
                 if (unit > 1 && (leaf || unit == half)) {
                     for (unsigned m = entered; m; m &= m - 1) {
                         const int k = std::countr_zero(m);
-                        if (coarse_child(p.lane[k], p.trace, d, n, int(c), co, half, unit, c0[c][k], c1[c][k]))
+                        if (coarse_child(p.lane[k], p.trace, d, n, int(c), co, half, unit, c0[k], c1[k]))
                             hit |= 1u << k;
                     }
                     active &= ~hit;
@@ -325,24 +430,24 @@ private:
             if (n.is_scalar_leaf(int(c))) {
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
-                    if (scalar_leaf(p.lane[k], p.trace, d, co, half, n.scalar[c], c0[c][k], c1[c][k])) hit |= 1u << k;
+                    if (scalar_leaf(p.lane[k], p.trace, d, co, half, n.scalar[c], c0[k], c1[k])) hit |= 1u << k;
                 }
             } else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;   // located once for every lane that crosses this cap
                 const CapRef<T> ci = tree_.cap(n, int(c));
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
-                    if (cap(p.lane[k], p.trace, ci, co, c0[c][k], c1[c][k], blocks)) hit |= 1u << k;
+                    if (cap(p.lane[k], p.trace, ci, co, c0[k], c1[k], blocks)) hit |= 1u << k;
                 }
             } else if (std::popcount(entered) < min_packet_lanes_) {
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
                     Walk& w = p.lane[k];
                     std::copy(p.trace, p.trace + d + 1, w.trace);
-                    if (node(w, d + 1, n.child_index(int(c)), co, c0[c][k], c1[c][k])) hit |= 1u << k;
+                    if (node(w, d + 1, n.child_index(int(c)), co, c0[k], c1[k])) hit |= 1u << k;
                 }
             } else {
-                hit = entered & ~packet_node(p, d + 1, n.child_index(int(c)), co, entered, flip, c0[c], c1[c]);
+                hit = entered & ~packet_node(p, d + 1, n.child_index(int(c)), co, entered, flip, c0, c1);
             }
             active &= ~hit;
         }
