@@ -39,6 +39,10 @@
 #include "util/check.h"
 #include "util/isa.h"
 
+#if defined(__AVX2__)
+#include <immintrin.h>   // the AVX2 kernel's PacketSplit: _mm256_movemask_pd
+#endif
+
 namespace octiso {
 OCTISO_ISA_BEGIN
 
@@ -353,7 +357,7 @@ private:
                 }
                 ok &= hi > lo;
                 store4(lo_ + 4 * h, lo), store4(hi_ + 4 * h, hi);
-                for (int j = 0; j < 4; ++j) entered |= unsigned(ok[j] & 1) << (4 * h + j);
+                entered |= unsigned(_mm256_movemask_pd(__m256d(ok))) << (4 * h);
             }
             return entered & active;
         }
