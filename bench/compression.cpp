@@ -152,10 +152,12 @@ double iso_for(const std::string& json, bool integer) {
 }
 
 /// Per-frame seconds of octiso-render from `dir` on `oct` (4 orbit frames), writing PNGs to
-/// `png_pattern` (a %d field).
+/// `png_pattern` (a %d field). `--no-embree` on both sides: a --baseline build from before issue
+/// 11 went through Embree by default, this one calls the traversal directly; the same path for
+/// both keeps the comparison about the format.
 double frame_seconds(const std::string& dir, const std::string& oct, double iso, const std::string& png_pattern) {
     const std::string json = run_tool("octiso-render", {oct, "--iso", fmt(iso, 6), "-o", png_pattern, "--orbit", "4",
-                                                        "--threads", "1", "--size", "384x384", "--json"}, dir);
+                                                        "--threads", "1", "--size", "384x384", "--no-embree", "--json"}, dir);
     double total = 0;
     for (size_t at = json.find("\"frame_seconds\":"); at != std::string::npos; at = json.find("\"frame_seconds\":", at + 1))
         total += std::strtod(json.c_str() + at + 16, nullptr);

@@ -52,7 +52,12 @@ struct RenderOptions {
     bool want_colour = true;            ///< false: depth-only renders skip shading
     bool want_depth = false;
     bool want_normal = false;
-    bool use_embree = true;             ///< false: call the traversal directly (no Embree dispatch)
+    /// true: primary rays through an Embree scene holding the volume as a user geometry (the
+    /// path a scene mixing meshes and volumes takes). false (the default since issue 11): the
+    /// scene holds only the volume, so the traversal is called directly; the same pixels
+    /// (RenderPaths.EmbreeAndDirectGiveIdenticalFrames) for 4-7 % less per frame (BENCHMARKS.md,
+    /// packet section: "packets, Embree" against the direct rows).
+    bool use_embree = false;
     Traversal traversal = Traversal::packets;
     Isa isa = Isa::automatic;
     /// Expert: a packet continues while at least this many lanes enter a subtree; 0 keeps the

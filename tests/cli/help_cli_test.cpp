@@ -20,7 +20,7 @@ const ToolFlags kTools[] = {
     {"octiso-render",
      {"-o, --output", "--depth", "--normal", "--json", "--steps", "--view", "--azimuth", "--elevation", "--zoom", "--orbit", "--eye",
       "--look", "--up", "--fov", "--size", "--spp", "--lod", "--shading", "--background", "--colour", "--root-finder", "--iterations",
-      "--no-embree", "--threads", "--debug-pixel", "--version", "--help", "--iso", "--traversal", "--isa", "--distribute", "--shadows",
+      "--embree", "--no-embree", "--threads", "--debug-pixel", "--version", "--help", "--iso", "--traversal", "--isa", "--distribute", "--shadows",
       "--ao", "--ao-distance", "--opacity", "--clip", "--clip-cap", "--progress"}},
     {"octiso-info", {"--json", "--bins", "--verify", "--extract-raw", "--step", "--endian", "--version", "--help"}},
     {"octiso-convert",

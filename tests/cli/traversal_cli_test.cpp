@@ -42,9 +42,11 @@ TEST_F(TraversalCli, EveryTraversalAndIsaDrawsTheSameBytes) {
     const ToolRun base = render("", "default");
     ASSERT_EQ(base.status, 0) << base.err;
     EXPECT_NE(base.out.find("\"traversal\":\"packets\""), std::string::npos) << base.out;
+    EXPECT_NE(base.out.find("\"embree\":false"), std::string::npos) << base.out;   // the default: direct
     std::vector<std::string> flags{"--traversal single", "--traversal packets", "--isa baseline", "--isa auto",
-                                   "--traversal single --isa baseline --no-embree"};
-    if (cpu_has_avx2()) flags.push_back("--isa avx2 --no-embree");
+                                   "--traversal single --isa baseline --no-embree", "--embree",
+                                   "--traversal single --embree"};
+    if (cpu_has_avx2()) flags.push_back("--isa avx2 --embree");
     int i = 0;
     for (const std::string& f : flags) {
         const std::string name = "v" + std::to_string(i++);
@@ -55,6 +57,9 @@ TEST_F(TraversalCli, EveryTraversalAndIsaDrawsTheSameBytes) {
         ASSERT_EQ(depth.pixels.size(), base_depth.pixels.size()) << f;
         EXPECT_EQ(0, std::memcmp(depth.pixels.data(), base_depth.pixels.data(), depth.pixels.size() * sizeof(float))) << f;
     }
+    const ToolRun both = render("--embree --no-embree", "both");
+    EXPECT_EQ(both.status, 2) << both.err;
+    EXPECT_NE(both.err.find("--embree"), std::string::npos) << both.err;
     const ToolRun single = render("--traversal single --isa baseline", "named");
     EXPECT_NE(single.out.find("\"traversal\":\"single\""), std::string::npos) << single.out;
     EXPECT_NE(single.out.find("\"isa\":\"baseline\""), std::string::npos) << single.out;
