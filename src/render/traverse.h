@@ -137,11 +137,13 @@ public:
             const auto& dir = p.lane[k].ray.dir;
             by_flip[(dir[0] < 0 ? 4 : 0) | (dir[1] < 0 ? 2 : 0) | (dir[2] < 0 ? 1 : 0)] |= 1u << k;
         }
+#if defined(__AVX2__)
         for (int a = 0; a < 3; ++a)
             for (int k = 0; k < kMaxPacket; ++k) {
                 const IndexRay& r = p.lane[k].ray;
                 p.origin[a][k] = r.origin[a], p.dir[a][k] = r.dir[a], p.inv_dir[a][k] = r.inv_dir[a];
             }
+#endif
         for (int flip = 0; flip < 8; ++flip) {
             const unsigned lanes = by_flip[flip];
             if (!lanes) continue;
@@ -291,9 +293,11 @@ private:
         Walk lane[kMaxPacket];
         // Every lane's entry is set, unused ones to an empty piece: packet_node reads all of them.
         alignas(32) double t0[kMaxPacket], t1[kMaxPacket];
-        /// The lanes' index rays by axis (lane k at [a][k]; unused lanes zero) for packet_node's
-        /// four-lane arithmetic.
+#if defined(__AVX2__)
+        /// The lanes' index rays by axis (lane k at [a][k]; unused lanes zero) for the AVX2
+        /// kernel's four-lane PacketSplit.
         alignas(32) double origin[3][kMaxPacket], dir[3][kMaxPacket], inv_dir[3][kMaxPacket];
+#endif
         uint32_t trace[kMaxDepth];
     };
 
@@ -304,7 +308,7 @@ private:
     /// start child and c), min(t1, times of the other planes it crosses)): the running max and the
     /// next crossing of node()'s walk (for_each_child_piece), the same numbers by the same
     /// operations, so the same pieces bit for bit; a child it does not reach gets an empty piece.
-    /// Computed only for the children that survive the cull: 0.77-0.99 x the frame time of the
+    /// Computed only for the children that survive the cull: 0.69-0.95 x the frame time of the
     /// per-lane walk below (BENCHMARKS.md, packet section, the A/B). The portable kernel keeps the
     /// walk: there GCC lowers these 4-wide vectors to SSE halves so badly that frames took
     /// 1.7-2.0 x as long, and a scalar version of this split lost to the walk as well.
