@@ -55,8 +55,8 @@ struct RenderOptions {
     /// true: primary rays through an Embree scene holding the volume as a user geometry (the
     /// path a scene mixing meshes and volumes takes). false (the default since issue 11): the
     /// scene holds only the volume, so the traversal is called directly; the same pixels
-    /// (RenderPaths.EmbreeAndDirectGiveIdenticalFrames) for 4-7 % less per frame (BENCHMARKS.md,
-    /// packet section: "packets, Embree" against the direct rows).
+    /// (RenderPaths.EmbreeAndDirectGiveIdenticalFrames) for 0-9 % less per frame (medians of
+    /// bench/results/build_ab_direct_default.json; BENCHMARKS.md, Embree dispatch).
     bool use_embree = false;
     Traversal traversal = Traversal::packets;
     Isa isa = Isa::automatic;

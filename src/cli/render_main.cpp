@@ -85,7 +85,7 @@ const char* kUsage =
     "  --root-finder NAME        neubauer|schwarze|linear|exact (default neubauer)\n"
     "  --iterations N            refinement steps of the root finder (default: its own, neubauer 5)\n"
     "  --embree                  primary rays through an Embree scene holding the volume (same image; default:\n"
-    "                            the traversal is called directly, 4-7 % less per frame)\n"
+    "                            the traversal is called directly, 0-9 % less per frame)\n"
     "  --no-embree               the traversal directly: the default (kept for scripts that pass it)\n"
     "  --traversal packets|single  8-ray packets of 4x2 pixels, or one ray at a time (default packets;\n"
     "                            same image)\n"
