@@ -1,7 +1,7 @@
 // octiso-bench compression (issue 2, item 9; issue 19): how small the lossless octree is, against
 // the raw array and against zstd -3 of the raw, where its bytes go (scalars, bounds, indices, caps)
-// in format 3 and in format 2 (the wide layout before issue 19, whose sizes follow exactly from the
-// same node and cap counts), how fast it builds and how much memory the build takes, per
+// in this build's format and in format 2 (the wide layout before issue 19, whose sizes follow
+// exactly from the same node and cap counts), how fast it builds and how much memory the build takes, per
 // dataset: the synthetic fields at --size N (ct-head at N x N x N/2), the real CT of
 // invesalius-examples (Cranium, i16) when installed, and the single-component MRI volumes of
 // mricron-data. Each conversion runs in its own octiso-convert process, so peak RSS is that one
@@ -9,8 +9,8 @@
 // NIfTI with the file's own stored bytes, the rest with the voxels generated or read here).
 // --frames adds the frame time of octiso-render on each file (1 thread, 4 orbit frames at
 // 384^2, the minimum of 3 rounds); --baseline DIR renders the same data converted by the tools
-// in DIR (a build of an earlier commit, e.g. format 2) interleaved with ours, and checks that the
-// images are identical.
+// in DIR (a build of an earlier commit, e.g. format 4) interleaved with ours, reports its file
+// size, and checks that the images are identical.
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -391,20 +391,25 @@ int run_compression(cli::Args& args) {
     std::cout << "octiso-bench compression: " << machine_description() << "\n";
     table.print(std::cout);
     if (markdown) table.print_markdown(std::cout);
-    // Where the bytes go, format 3 against format 2 (issue 19), and the frame time where measured.
+    // Where the bytes go, this format against format 2 and the baseline (issue 19), and the frame time where measured.
     Table parts({"dataset", "type", "nodes", "caps", "scalars MiB", "bounds MiB", "indices MiB", "caps MiB", "% raw",
-                 "format 2: min/max MiB", "caps MiB", "% raw", "zstd-3 % raw", "iso", "frame ms", "baseline ms", "speed-up",
-                 "same image"});
+                 "baseline % raw", "format 2: min/max MiB", "caps MiB", "% raw", "zstd-3 % raw", "iso", "frame ms",
+                 "baseline ms", "speed-up", "same image"});
     for (const Result& r : rows) {
         const bool b = r.baseline_frame.has_value();
-        parts.add({r.set.name, r.type, std::to_string(r.interior_nodes), std::to_string(r.caps),
-                   mib(r.interior_nodes * 8 * r.scalar_bytes_size), mib(r.minmax_bytes), mib(r.interior_nodes * 8),
-                   mib(r.cap_bytes), fmt(r.percent(), 1), mib(r.format2_minmax()), mib(r.format2_caps()),
+        // Indices: what the interior levels hold beside scalars and bounds (child offsets, masks,
+        // cap widths, group bases and their padding).
+        const uint64_t scalars = r.interior_nodes * 8 * r.scalar_bytes_size;
+        parts.add({r.set.name, r.type, std::to_string(r.interior_nodes), std::to_string(r.caps), mib(scalars),
+                   mib(r.minmax_bytes), mib(r.interior_bytes - scalars - r.minmax_bytes), mib(r.cap_bytes),
+                   fmt(r.percent(), 1), b ? fmt(100.0 * double(r.baseline_file_bytes) / double(r.raw_bytes), 1) : "-",
+                   mib(r.format2_minmax()), mib(r.format2_caps()),
                    fmt(r.format2_percent(), 1), fmt(r.zstd_percent(), 1), fmt(r.iso, 6),
                    r.frame ? fmt(1e3 * *r.frame, 1) : "-", b ? fmt(1e3 * *r.baseline_frame, 1) : "-",
                    b ? fmt(*r.baseline_frame / *r.frame, 3) : "-", b ? (r.baseline_images_equal ? "yes" : "NO") : "-"});
     }
-    std::cout << "\nbytes by part (format 3) and format 2 from the same counts; frames: 1 thread, 384^2, min of 3 rounds\n";
+    std::cout << "\nbytes by part (this format), the baseline's file and format 2 from the same counts; frames: 1 thread, "
+                 "384^2, min of 3 rounds\n";
     parts.print(std::cout);
     if (markdown) parts.print_markdown(std::cout);
     print_targets(std::cout, rows, size);

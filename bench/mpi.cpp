@@ -75,7 +75,7 @@ template <typename T> uint64_t brick_bytes(const Octree<T>& t, const CellBox& b)
             const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
             if (n.is_scalar_leaf(c) || !meets(co, half)) continue;
             if (d + 1 == t.dmax() - 1) bytes += n.cap_bits;   // a packed cap (octree.h)
-            else self(self, d + 1, n.child_index(c), co);
+            else self(self, d + 1, t.child_index(d, index, n, c), co);
         }
     };
     visit(visit, 0, 0, Coord{});

@@ -8,7 +8,10 @@ same pixels (idiff -fail 0: a change meant to keep the image must).
 
     scripts/build_ab.py --a /work/wt-old/build/octiso-render [--b build/octiso-render] [--pairs 5]
                         [--threads 1] [--size 512x512] [--orbit 8] [--flags '--no-embree']
-                        [--results DIR] [--tag NAME] FILE.oct@ISO [FILE.oct@ISO ...]
+                        [--results DIR] [--tag NAME] FILE.oct[,B_FILE.oct]@ISO ...
+
+FILE.oct,B_FILE.oct: a format change, each build on its own conversion of the same voxels (A on FILE,
+B on B_FILE); the images are compared all the same.
 
 --results DIR writes build_ab[_NAME].json there (default: a temporary folder, printed). Used for
 BENCHMARKS.md, "Packet traversal and ISA kernels" (the cap corner lattice)."""
@@ -42,7 +45,7 @@ def same_pixels(outdir, orbit):
 
 def main():
     p = argparse.ArgumentParser()
-    p.add_argument("datasets", nargs="+", help="FILE.oct@ISO")
+    p.add_argument("datasets", nargs="+", help="FILE.oct[,B_FILE.oct]@ISO")
     p.add_argument("--a", required=True, help="octiso-render before the change")
     p.add_argument("--b", default="build/octiso-render", help="octiso-render with the change")
     p.add_argument("--pairs", type=int, default=5)
@@ -58,14 +61,15 @@ def main():
     print("|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as outdir:
         for spec in a.datasets:
-            path, iso = spec.rsplit("@", 1)
+            paths, iso = spec.rsplit("@", 1)
+            path, b_path = (paths.split(",", 1) + [None])[:2] if "," in paths else (paths, paths)
             t = {"A": [], "B": []}
             for pair in range(a.pairs):
                 order = ("A", "B") if pair % 2 == 0 else ("B", "A")
                 for tag in order:
-                    t[tag].append(render(a.a if tag == "A" else a.b, path, iso, a, outdir, tag))
+                    t[tag].append(render(a.a if tag == "A" else a.b, path if tag == "A" else b_path, iso, a, outdir, tag))
             same = same_pixels(outdir, a.orbit)
-            row = {"file": path, "iso": float(iso), "a_seconds": t["A"], "b_seconds": t["B"],
+            row = {"file": path, "b_file": b_path, "iso": float(iso), "a_seconds": t["A"], "b_seconds": t["B"],
                    "b_over_a_min": min(t["B"]) / min(t["A"]),
                    "b_over_a_median": statistics.median(t["B"]) / statistics.median(t["A"]), "same_pixels": same}
             rows.append(row)

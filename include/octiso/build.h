@@ -46,7 +46,7 @@ struct BuildPhases {
 struct BuildStats {
     std::vector<uint64_t> nodes_per_depth;
     std::vector<uint64_t> scalar_leaves_per_depth;
-    uint64_t interior_bytes = 0;   ///< all InteriorNode records, bounds included
+    uint64_t interior_bytes = 0;   ///< all interior levels as the file holds them (records, group bases)
     uint64_t minmax_bytes = 0;     ///< the part of interior_bytes that is child bounds
     uint64_t cap_bytes = 0;        ///< packed cap records
     double seconds = 0;
@@ -68,6 +68,7 @@ public:
     Dims dims;
     int dmax = 0;
     std::vector<UninitArray<InteriorNode<T>>> nodes;   ///< [depth 0 .. dmax-2]
+    std::vector<UninitArray<uint64_t>> group_bases;    ///< [depth 0 .. dmax-2], node_groups(count) each
     UninitArray<uint8_t> caps;    ///< packed cap records, then kCapReadSlack zero bytes
     uint64_t cap_bytes = 0;       ///< records only
     uint64_t cap_count = 0;

@@ -45,7 +45,9 @@ public:
 
     /// A step streamed section by section (the out-of-core converter, whose arrays never sit in
     /// memory whole): for d = 0 .. dmax-1 in order, begin_section(d, count), append_records() with
-    /// exactly count records (InteriorNode<T>, Caps at dmax-1) in as many calls as convenient, then
+    /// exactly count records (InteriorNode<T>, Caps at dmax-1) in as many calls as convenient, and
+    /// after an interior level's records 0-7 zero bytes to a multiple of 8 and its group bases
+    /// (oct_layout.h: the section is interior_section_bytes(count) in all), then
     /// end_section(); the step counts once its caps section ends. The checksum is computed as the
     /// bytes pass. The caller validates the records (it alone sees them all, one chunk at a time).
     void begin_section(int depth, uint64_t count);

@@ -10,9 +10,10 @@
 // child_bit(d) = 2^(dmax-d-1). Child octant c = x<<2 | y<<1 | z, where x = 1 for the upper half.
 //
 // The compact layout (issue 19; measured by `octiso-bench compression`, BENCHMARKS.md):
-//  - child bounds are quantized conservatively to 8 bits inside the node's own exact range
-//    (Knoll 2006 stored 8-bit min/max too); 1-byte scalars keep their exact bounds, which are
-//    no larger;
+//  - child bounds are quantized conservatively inside the node's own exact range: 8 bits for
+//    wider scalars (Knoll 2006 stored 8-bit min/max too), 4 bits for 1-byte scalars (format 5);
+//  - a node's first child is a 64-bit base per group of 128 nodes plus a 16-bit offset
+//    (format 5), not a 48-bit number per node;
 //  - a cap is stored as 8 deltas of `cap_bits` bits from a base held in its parent's scalar slot
 //    (the base is the cap's smallest voxel, in the order of ScalarKey), all caps of one parent
 //    with the same width, so that a cap of b bits takes b bytes and is found by a multiply;
@@ -60,8 +61,8 @@ template <typename T> inline constexpr unsigned kWholeCapBits = 8 * sizeof(T);
 /// The widest delta a packed (not whole) cap may have: base + deltas must be smaller than the
 /// whole cap, and every delta must come out of one unaligned 64-bit load (shift <= 7).
 template <typename T> inline constexpr unsigned kMaxDeltaBits = 8 * sizeof(T) - 1 < 56 ? 8 * sizeof(T) - 1 : 56;
-/// A cap parent's first_child() is a 48-bit byte offset: the cap level of one step holds at most
-/// this many bytes (2^48, 256 TiB; interior levels keep 32-bit node indices).
+/// The cap level of one step holds at most this many bytes (2^48, 256 TiB; interior levels keep
+/// 32-bit node indices, which the traversal's parent traces hold).
 inline constexpr uint64_t kMaxCapByteOffset = uint64_t(1) << 48;
 /// Zero bytes after the last cap of a level, so that every delta is one 8-byte load in bounds.
 inline constexpr uint64_t kCapReadSlack = 8;
@@ -69,45 +70,43 @@ inline constexpr uint64_t kCapReadSlack = 8;
 /// ChildBounds<T>: [lower(c), upper(c)] contains the trilinear interpolant on every data cell
 /// whose lower corner lies in child c (the one-voxel forward layer +x,+y,+z counts). With no
 /// such cell (pure padding or the last data layer) the bounds are empty and traversal skips the
-/// child. 1-byte scalars: the exact min/max. Wider ones: 8-bit codes inside [lo, hi], the exact
-/// range of the node's children together, in steps of s = hi/255 - lo/255 (finite for every
-/// double range): a lower code q stands for lo + q s (0: lo exactly), an upper code q for
-/// hi - (255 - q) s (255: hi exactly). No branch and no select in the decode (the first version,
-/// 0 and 255 as special cases, cost packet_node 19 %, perf on Marschner-Lobb 256^3). The packer
-/// picks the largest lower and smallest upper code that still contain the true range (it runs
-/// this same decode), and qmin > qmax marks an empty child.
-template <typename T, bool kExact = (sizeof(T) == 1)> struct ChildBounds;
-
-template <typename T> struct ChildBounds<T, true> {
-    T min[8];
-    T max[8];
-    OCTISO_ALWAYS_INLINE bool empty(int c) const { return min[c] > max[c]; }
-    OCTISO_ALWAYS_INLINE double lower(int c) const { return double(min[c]); }
-    OCTISO_ALWAYS_INLINE double upper(int c) const { return double(max[c]); }
-    /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
-    double range_lo() const {
-        double v = std::numeric_limits<double>::infinity();
-        for (int c = 0; c < 8; ++c) if (!empty(c) && double(min[c]) < v) v = double(min[c]);
-        return v;
-    }
-    double range_hi() const {
-        double v = -std::numeric_limits<double>::infinity();
-        for (int c = 0; c < 8; ++c) if (!empty(c) && double(max[c]) > v) v = double(max[c]);
-        return v;
-    }
-};
-
-template <typename T> struct ChildBounds<T, false> {
+/// child. Codes of kCodeBits bits inside [lo, hi], the exact range of the node's children
+/// together, in steps of s = hi/top - lo/top (top = 2^kCodeBits - 1; finite for every double
+/// range): a lower code q stands for lo + q s (0: lo exactly), an upper code q for
+/// hi - (top - q) s (top: hi exactly). Wider scalars take 8-bit codes (Knoll 2006 stored 8-bit
+/// min/max); 1-byte scalars 4-bit codes, both codes of a child in one byte (format 5, issue 19:
+/// their exact 8-bit bounds were half of a u8 node; the cost is 9-10 % more cap children that pass
+/// the cull on plume and mixing, measured in BENCHMARKS.md "The compact octree, format 5"). No
+/// branch and no select in the decode (the first version, 0 and top as special cases, cost
+/// packet_node 19 %, perf on Marschner-Lobb 256^3). The packer picks the largest lower and
+/// smallest upper code that still contain the true range (it runs this same decode), and
+/// qmin > qmax marks an empty child.
+template <typename T> struct ChildBounds {
+    static constexpr bool kNibbles = sizeof(T) == 1;
+    static constexpr int kCodeBits = kNibbles ? 4 : 8;
+    static constexpr int kTop = (1 << kCodeBits) - 1;
     T lo, hi;
-    uint8_t qmin[8];
-    uint8_t qmax[8];
-    static constexpr int kTop = 255;
+    /// kNibbles: codes[c] = qmin | qmax << 4; else qmin at codes[c], qmax at codes[8 + c].
+    uint8_t codes[kNibbles ? 8 : 16];
+
+    OCTISO_ALWAYS_INLINE int qmin(int c) const {
+        if constexpr (kNibbles) return codes[c] & 15;
+        else return codes[c];
+    }
+    OCTISO_ALWAYS_INLINE int qmax(int c) const {
+        if constexpr (kNibbles) return codes[c] >> 4;
+        else return codes[8 + c];
+    }
+    void set_codes(int c, int ql, int qh) {
+        if constexpr (kNibbles) codes[c] = uint8_t(ql | qh << 4);
+        else codes[c] = uint8_t(ql), codes[8 + c] = uint8_t(qh);
+    }
     OCTISO_ALWAYS_INLINE double step() const { return double(hi) * (1.0 / kTop) - double(lo) * (1.0 / kTop); }
     OCTISO_ALWAYS_INLINE double decode_lower(int q, double step) const { return double(lo) + double(q) * step; }
     OCTISO_ALWAYS_INLINE double decode_upper(int q, double step) const { return double(hi) - double(kTop - q) * step; }
-    OCTISO_ALWAYS_INLINE bool empty(int c) const { return qmin[c] > qmax[c]; }
-    OCTISO_ALWAYS_INLINE double lower(int c) const { return decode_lower(qmin[c], step()); }
-    OCTISO_ALWAYS_INLINE double upper(int c) const { return decode_upper(qmax[c], step()); }
+    OCTISO_ALWAYS_INLINE bool empty(int c) const { return qmin(c) > qmax(c); }
+    OCTISO_ALWAYS_INLINE double lower(int c) const { return decode_lower(qmin(c), step()); }
+    OCTISO_ALWAYS_INLINE double upper(int c) const { return decode_upper(qmax(c), step()); }
     /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
     double range_lo() const {
         for (int c = 0; c < 8; ++c) if (!empty(c)) return double(lo);
@@ -119,38 +118,45 @@ template <typename T> struct ChildBounds<T, false> {
     }
 };
 
+/// Nodes per child group (format 5, issue 19): a node's first child is its group's base, a 64-bit
+/// number stored after the level's records (group_base), plus the node's own 16-bit
+/// child_offset. 128 keeps every offset inside 16 bits for every type: the children of 127
+/// nodes take at most 127 x 8 whole caps of 8 x 8 bytes (doubles) = 65024 bytes. The bases cost
+/// 1/16 byte a node; the 48-bit first child they replace cost 4 bytes more a node.
+inline constexpr uint64_t kNodeGroupShift = 7;
+inline constexpr uint64_t kNodeGroup = uint64_t(1) << kNodeGroupShift;
+/// Group bases of a level of `count` nodes.
+inline constexpr uint64_t node_groups(uint64_t count) { return (count + kNodeGroup - 1) >> kNodeGroupShift; }
+
+/// Zero bytes that keep every record of the widest type a multiple of its alignment with no
+/// padding the compiler would add (and leave indeterminate); empty for the other types.
+template <typename T> struct RecordTail {};
+template <> struct RecordTail<double> { uint32_t zero = 0; };
+
 /// InteriorNode<T>: a node at depth d, 0 <= d <= dmax-2. For each child octant c:
 ///   child_mask bit c clear: child c is a scalar leaf; every voxel of it equals scalar[c]
 ///                           (padding beyond the data excepted: it is "don't care").
 ///   child_mask bit c set:   child c is stored at depth d+1. Below depth dmax-2 it is the
-///                           InteriorNode at index first_child() + rank(c) (rank: stored children
-///                           before c) and scalar[c] is the voxel at its lower corner (format 4:
-///                           the level-of-detail lattice sample, see lattice_value). At depth
-///                           dmax-2 it is a cap: its record starts at byte first_child() + rank(c)
-///                           * cap_bits of the caps (8 deltas of b bits are b bytes), and scalar[c]
-///                           is its base.
+///                           InteriorNode at index first + rank(c) (first: Octree::first_child,
+///                           the group base plus child_offset; rank: stored children before c)
+///                           and scalar[c] is the voxel at its lower corner (the level-of-detail
+///                           lattice sample, see lattice_value). At depth dmax-2 it is a cap: its
+///                           record starts at byte first + rank(c) * cap_bits of the caps (8
+///                           deltas of b bits are b bytes), and scalar[c] is its base.
 ///   bounds: ChildBounds above.
-/// The loader validates that the children of consecutive nodes follow each other exactly and
-/// stay inside the level below, and that cap_bits is kWholeCapBits or at most kMaxDeltaBits.
+/// Every node's first child is where the previous node's children end (the first node's is 0),
+/// childless nodes included, so the whole index is the prefix sum of children_span(); the loader
+/// validates exactly that, and that cap_bits is kWholeCapBits or at most kMaxDeltaBits.
 template <typename T> struct InteriorNode {
-    uint32_t child_start;      ///< low 32 bits of first_child()
-    uint16_t child_start_hi;   ///< bits 32..47 (caps only: byte offsets; zero above depth dmax-2)
-    uint8_t child_mask;
-    uint8_t cap_bits;          ///< depth dmax-2: bits per cap voxel; zero above
     T scalar[8];
     ChildBounds<T> bounds;
+    uint16_t child_offset;     ///< first child, relative to the group's base
+    uint8_t child_mask;
+    uint8_t cap_bits;          ///< depth dmax-2: bits per cap voxel; zero above
+    [[no_unique_address]] RecordTail<T> tail;
 
-    OCTISO_ALWAYS_INLINE uint64_t first_child() const { return uint64_t(child_start) | uint64_t(child_start_hi) << 32; }
-    void set_first_child(uint64_t v) {
-        child_start = uint32_t(v);
-        child_start_hi = uint16_t(v >> 32);
-    }
     OCTISO_ALWAYS_INLINE bool is_scalar_leaf(int c) const { return ((child_mask >> c) & 1u) == 0; }
     OCTISO_ALWAYS_INLINE uint32_t rank(int c) const { return uint32_t(std::popcount(unsigned(child_mask) & ((1u << c) - 1u))); }
-    /// Index of stored child c at depth d+1 (d < dmax-2).
-    OCTISO_ALWAYS_INLINE uint32_t child_index(int c) const { return child_start + rank(c); }
-    /// Byte offset of cap child c among the caps (d == dmax-2).
-    OCTISO_ALWAYS_INLINE uint64_t cap_offset(int c) const { return first_child() + uint64_t(rank(c)) * cap_bits; }
     /// What the stored children take in the level below: nodes, or (`caps_below`, a cap parent)
     /// bytes of caps. The builders and the validator place and check children by it.
     uint64_t children_span(bool caps_below) const {
@@ -164,6 +170,12 @@ template <typename T> struct InteriorNode {
         return false;
     }
 };
+
+/// Bytes of one level of `count` nodes as a .oct section holds it (src/format/oct_layout.h): the
+/// records, zero bytes up to a multiple of 8, then the node_groups(count) 64-bit group bases.
+template <typename T> constexpr uint64_t interior_level_bytes(uint64_t count) {
+    return ((count * sizeof(InteriorNode<T>) + 7) & ~uint64_t(7)) + 8 * node_groups(count);
+}
 
 /// Cap<T>: the 2x2x2 voxels of a node at depth dmax-1, octant order as above; the builders' form
 /// of a cap before packing, and what CapRef decodes to.
@@ -231,6 +243,7 @@ template <typename T> struct OctreeArrays {
     int dmax = 0;
     std::array<const InteriorNode<T>*, kMaxDepth> nodes{};   ///< depth 0 .. dmax-2
     std::array<uint64_t, kMaxDepth> node_count{};
+    std::array<const uint64_t*, kMaxDepth> group_base{};   ///< depth 0 .. dmax-2: node_groups(count) each
     const uint8_t* caps = nullptr;   ///< depth dmax-1: packed cap records, then kCapReadSlack zero bytes
     uint64_t cap_bytes = 0;          ///< records only (the slack not counted)
     uint64_t cap_count = 0;
@@ -251,9 +264,19 @@ public:
     uint64_t cap_count() const { return a_.cap_count; }
     uint64_t cap_bytes() const { return a_.cap_bytes; }
     const InteriorNode<T>& node(int d, uint64_t i) const { return a_.nodes[size_t(d)][i]; }
-    /// Cap child c of `parent`, a node at depth dmax-2.
-    OCTISO_ALWAYS_INLINE CapRef<T> cap(const InteriorNode<T>& parent, int c) const {
-        return {a_.caps + parent.cap_offset(c), parent.cap_bits, parent.scalar[c]};
+    /// Where the children of node i at depth d start in the level below: a node index, or (d =
+    /// dmax-2) a byte offset into the caps.
+    OCTISO_ALWAYS_INLINE uint64_t first_child(int d, uint64_t i) const {
+        return a_.group_base[size_t(d)][i >> kNodeGroupShift] + a_.nodes[size_t(d)][i].child_offset;
+    }
+    /// Index at depth d+1 of stored child c of `n`, node i at depth d < dmax-2.
+    OCTISO_ALWAYS_INLINE uint32_t child_index(int d, uint64_t i, const InteriorNode<T>& n, int c) const {
+        return uint32_t(a_.group_base[size_t(d)][i >> kNodeGroupShift] + n.child_offset + n.rank(c));
+    }
+    /// Cap child c of `parent`, node i at depth dmax-2.
+    OCTISO_ALWAYS_INLINE CapRef<T> cap(uint64_t i, const InteriorNode<T>& parent, int c) const {
+        const uint64_t first = a_.group_base[size_t(a_.dmax - 2)][i >> kNodeGroupShift] + parent.child_offset;
+        return {a_.caps + first + uint64_t(parent.rank(c)) * parent.cap_bits, parent.cap_bits, parent.scalar[c]};
     }
     const OctreeArrays<T>& arrays() const { return a_; }
 
@@ -266,8 +289,8 @@ public:
             const InteriorNode<T>& n = a_.nodes[size_t(depth)][index];
             const int c = octant_of(p, child_bit(depth));
             if (n.is_scalar_leaf(c)) return {n.scalar[c], false, {}, 0};
-            if (depth == cap_parents_at) return {T{}, true, this->cap(n, c), octant_of(p, 1u)};
-            index = n.child_index(c);
+            if (depth == cap_parents_at) return {T{}, true, this->cap(index, n, c), octant_of(p, 1u)};
+            index = child_index(depth, index, n, c);
             ++depth;
         }
     }
@@ -316,9 +339,9 @@ public:
             const uint32_t half = child_bit(d);
             const int c = octant_of(q, half);
             if (n.is_scalar_leaf(c)) return n.scalar[c];
-            if (d == cap_parents_at) return this->cap(n, c).voxel(octant_of(q, 1u));
+            if (d == cap_parents_at) return this->cap(index, n, c).voxel(octant_of(q, 1u));
             if (half <= unit) return n.scalar[c];   // q is this child's lower corner
-            index = n.child_index(c);
+            index = child_index(d, index, n, c);
             ++d;
         }
     }

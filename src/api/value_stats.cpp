@@ -57,12 +57,12 @@ void walk_node(const Octree<T>& tree, int depth, uint64_t index, uint32_t x0, ui
             visit(node.scalar[c], n);
         } else if (depth + 1 == tree.cap_depth()) {
             T voxel[8];
-            tree.cap(node, c).decode(voxel);
+            tree.cap(index, node, c).decode(voxel);
             for (int o = 0; o < 8; ++o)
                 if (x + ((o >> 2) & 1) < dims.x && y + ((o >> 1) & 1) < dims.y && z + (o & 1) < dims.z)
                     visit(voxel[o], 1);
         } else {
-            walk_node(tree, depth + 1, node.child_index(c), x, y, z, visit);
+            walk_node(tree, depth + 1, tree.child_index(depth, index, node, c), x, y, z, visit);
         }
     }
 }

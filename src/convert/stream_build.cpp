@@ -3,9 +3,9 @@
 //     the input is read once), condition them (prepare.h, on the slab), build the slab's pieces in
 //     parallel (piece_builder.h) and append their arrays, per depth, to the spill files;
 //  2. the top: the nodes above the pieces' depth k, from their root summaries in depth-first order;
-//  3. sections: depth by depth, the pieces' chunks read back in depth-first order, child_start
-//     offset by the children earlier pieces own, checked (contiguous, within the next depth,
-//     32-bit) and streamed into the writer, which checksums them as they pass.
+//  3. sections: depth by depth, the pieces' chunks read back in depth-first order, their children
+//     placed as they pass (child_groups.h), checked (the next depth covered exactly, 32-bit) and
+//     streamed into the writer with the group bases after them; it checksums them as they pass.
 #include "convert/stream_build.h"
 
 #include <algorithm>
@@ -23,6 +23,7 @@
 
 #include "convert/spill_file.h"
 #include "octiso/error.h"
+#include "octree/child_groups.h"
 #include "octree/piece_builder.h"
 #include "octree/prepare.h"
 #include "util/check.h"
@@ -179,20 +180,16 @@ private:
         const Builder<T> builder(VolumeView<T>{}, dims_, dmax_, options_.tolerance);
         std::vector<uint64_t> order;
         order.reserve(n_pieces_);
-        uint64_t stored_at_k = 0;
         auto descend = [&](auto&& self, int d, Coord o) -> Summary<T> {
             if (builder.outside(o)) return Summary<T>::padding();
             if (d == k_) {
                 const uint64_t id = piece_id(o);
                 order.push_back(id);
-                const Summary<T>& s = roots_[id];
-                if (!s.is_leaf) ++stored_at_k;
-                return s;
+                return roots_[id];
             }
             Summary<T> ch[8];
-            const uint64_t start = d + 1 == k_ ? stored_at_k : top.nodes[size_t(d + 1)].size();
             for (int c = 0; c < 8; ++c) ch[c] = self(self, d + 1, detail::child_origin(o, c, builder.child_bit(d)));
-            return builder.combine(d, ch, start, top);
+            return builder.combine(d, ch, top);
         };
         if (k_ > 0) descend(descend, 0, Coord{});
         else order.push_back(0);
@@ -207,23 +204,25 @@ private:
         return n;
     }
 
-    // The check validate_tree() makes at load, node by node as the records pass: children in
-    // node order start where the previous node's end, and stay inside depth d+1 and 32 bits.
-    void place_children(InteriorNode<T>& n, uint64_t base, uint64_t& expected, uint64_t next_count, int d) const {
-        // Every node is offset, childless ones too: build.cpp's concatenation does so, and a
-        // childless node's child_start is then where its children would start (the same bytes).
-        const bool caps_below = d + 1 == dmax_ - 1;   // then offsets and counts are bytes
-        const uint64_t global = n.first_child() + base;
-        const uint64_t end = global + n.children_span(caps_below);
-        if (end > (caps_below ? kMaxCapByteOffset : uint64_t(1) << 32))
+    // Places the children of section d's nodes as they pass (child_groups.h) and checks what
+    // validate_tree() checks at load: the children cover depth d+1 exactly, within 32-bit node
+    // indices (or 48-bit cap offsets).
+    void check_children(const detail::GroupPlacer& placer, uint64_t next_count, int d) const {
+        const bool caps_below = d + 1 == dmax_ - 1;   // then counts are bytes
+        if (next_count > (caps_below ? kMaxCapByteOffset : uint64_t(1) << 32))
             throw Error(options_.source_name, caps_below ? "octree too large: more than 2^48 bytes of caps"
                                                          : "octree too large: more than 2^32 nodes at depth " +
                                                                std::to_string(d + 1) + " (32-bit child indices)");
-        n.set_first_child(global);
-        if (n.child_mask == 0) return;
-        OCTISO_CHECK(global == expected && end <= next_count, "depth ", d, ": children from ", global, " (expected ",
-                     expected, ") past ", next_count, " at depth ", d + 1);
-        expected = end;
+        OCTISO_CHECK(placer.children() == next_count, "depth ", d, " has children for ", placer.children(), " of ",
+                     next_count, " at depth ", d + 1);
+    }
+    // A section's group bases after its records (oct_layout.h): zero bytes to a multiple of 8, then the bases.
+    void append_group_bases(uint64_t count, const detail::GroupPlacer& placer) {
+        static constexpr uint8_t kZero[8] = {};
+        const uint64_t records = count * sizeof(InteriorNode<T>);
+        writer_.append_records(kZero, (8 - records % 8) % 8);
+        OCTISO_CHECK(placer.bases().size() == node_groups(count), placer.bases().size(), " group bases for ", count, " nodes");
+        writer_.append_records(placer.bases().data(), placer.bases().size() * sizeof(uint64_t));
     }
 
     // 3. Sections in depth order.
@@ -233,12 +232,12 @@ private:
         for (int d = 0; d < dmax_; ++d) total[size_t(d)] = count_at(d, top);
         OCTISO_CHECK(total[0] == 1, "the root level holds ", total[0], " nodes");
         for (int d = 0; d < k_; ++d) {
-            uint64_t expected = 0;
-            for (auto& n : top.nodes[size_t(d)]) place_children(n, 0, expected, total[size_t(d + 1)], d);
-            OCTISO_CHECK(expected == total[size_t(d + 1)], "depth ", d, " has children for ", expected, " of ",
-                         total[size_t(d + 1)], " nodes");
+            detail::GroupPlacer placer(d + 1 == dmax_ - 1);
+            for (auto& n : top.nodes[size_t(d)]) placer.place(n);
+            check_children(placer, total[size_t(d + 1)], d);
             writer_.begin_section(d, total[size_t(d)]);
             writer_.append_records(top.nodes[size_t(d)].data(), total[size_t(d)] * sizeof(InteriorNode<T>));
+            append_group_bases(total[size_t(d)], placer);
             writer_.end_section();
             sizes.scalar_leaves_per_depth.push_back(top.leaves[size_t(d)]);
         }
@@ -252,7 +251,7 @@ private:
             uint64_t acc = 0;
             for (uint64_t id = 0; id < n_pieces_; ++id) at[id] = acc, acc += counts_[size_t(l)][id];
             writer_.begin_section(d, total[size_t(d)] + (is_caps ? kCapReadSlack : 0));
-            uint64_t base = 0, expected = 0;
+            detail::GroupPlacer placer(d + 1 == dmax_ - 1);
             for (const uint64_t id : order) {
                 const uint64_t n = counts_[size_t(l)][id];
                 if (is_caps) {
@@ -262,15 +261,14 @@ private:
                 } else {
                     nodes.resize(n);
                     spill_[size_t(l)]->read(at[id] * record, n * record, nodes.data());
-                    for (auto& node : nodes) place_children(node, base, expected, total[size_t(d + 1)], d);
-                    base += counts_[size_t(l + 1)][id];
+                    for (auto& node : nodes) placer.place(node);
                     writer_.append_records(nodes.data(), n * record);
                 }
             }
-            if (!is_caps)
-                OCTISO_CHECK(expected == total[size_t(d + 1)], "depth ", d, " has children for ", expected, " of ",
-                             total[size_t(d + 1)], " nodes");
-            if (is_caps) {
+            if (!is_caps) {
+                check_children(placer, total[size_t(d + 1)], d);
+                append_group_bases(total[size_t(d)], placer);
+            } else {
                 static constexpr uint8_t kSlack[kCapReadSlack] = {};
                 writer_.append_records(kSlack, kCapReadSlack);
             }
@@ -278,8 +276,10 @@ private:
             sizes.scalar_leaves_per_depth.push_back(leaves_[size_t(d)]);
         }
         sizes.nodes_per_depth = total;
-        for (int d = 0; d + 1 < dmax_; ++d) sizes.interior_bytes += total[size_t(d)] * sizeof(InteriorNode<T>);
-        sizes.minmax_bytes = sizes.interior_bytes / sizeof(InteriorNode<T>) * sizeof(ChildBounds<T>);
+        for (int d = 0; d + 1 < dmax_; ++d) {
+            sizes.interior_bytes += interior_level_bytes<T>(total[size_t(d)]);
+            sizes.minmax_bytes += total[size_t(d)] * sizeof(ChildBounds<T>);
+        }
         sizes.cap_bytes = total[size_t(dmax_ - 1)];
         sizes.nodes_per_depth[size_t(dmax_ - 1)] = cap_count_;
         return sizes;

@@ -89,6 +89,8 @@ struct OctFile::Impl {
             const SectionEntry& s = section(k, d);
             a.nodes[size_t(d)] = reinterpret_cast<const InteriorNode<T>*>(base + s.offset);
             a.node_count[size_t(d)] = s.count;
+            a.group_base[size_t(d)] = reinterpret_cast<const uint64_t*>(
+                base + s.offset + format::group_bases_offset(s.count, scalar_type_bytes(info.type)));
         }
         const SectionEntry& c = section(k, info.dmax - 1);   // count >= kCapReadSlack (check_table)
         a.caps = reinterpret_cast<const uint8_t*>(base + c.offset);
@@ -185,6 +187,9 @@ void OctFile::Impl::check_header() {
     if (h.version == 3)
         fail("is .oct format version 3, whose stored children hold the midpoint of their range, not the corner "
              "voxel level of detail samples (format 4): convert the source again with octiso-convert");
+    if (h.version == 4)
+        fail("is .oct format version 4, the node layout before child groups and 4-bit bounds (format 5): convert "
+             "the source again with octiso-convert");
     if (h.version != format::kFormatVersion)
         fail("unsupported format version (expected " + num(format::kFormatVersion) + ", found " + num(h.version) + ")");
     if (h.header_bytes != sizeof(FileHeader))
@@ -278,9 +283,15 @@ void OctFile::Impl::check_table() {
         if (s.bytes > bytes || s.offset > bytes - s.bytes)
             fail(name + ": runs past end of file (" + num(s.bytes) + " bytes at offset " + num(s.offset) + ", file " +
                  num(bytes) + " bytes)");
-        if (s.count > s.bytes / rec || s.count * rec != s.bytes)
-            fail(name + ": byte size does not match the record count (expected " + num(s.count) + " x " + num(rec) +
-                 " bytes, found " + num(s.bytes) + ")");
+        // Interior sections hold their group bases after the records (oct_layout.h).
+        const uint64_t scalar = scalar_type_bytes(info.type);
+        if (s.count > s.bytes / rec ||
+            (is_caps ? s.count * rec : format::interior_section_bytes(s.count, scalar)) != s.bytes)
+            fail(name + ": byte size does not match the record count (expected " +
+                 (is_caps ? num(s.count) + " x " + num(rec) + " bytes"
+                          : num(format::interior_section_bytes(s.count, scalar)) + " bytes for " + num(s.count) +
+                                " records of " + num(rec) + " and their group bases") +
+                 ", found " + num(s.bytes) + ")");
         if (depth == 0 && s.count != 1)
             fail(name + ": the root level must hold exactly one node (expected 1, found " + num(s.count) + ")");
         if (is_caps && s.count < kCapReadSlack)
@@ -314,6 +325,11 @@ void OctFile::Impl::check_step_padding(uint32_t k) const {
         const SectionEntry& s = table[i];
         if (!all_zero(base + end, s.offset - end))
             fail("section " + num(i) + " (step " + num(k) + ", depth " + num(d) + "): padding before the section is not zero");
+        if (d + 1 == info.dmax) continue;
+        const uint64_t records = s.count * format::interior_record_bytes(scalar_type_bytes(info.type)), bases = format::group_bases_offset(s.count, scalar_type_bytes(info.type));
+        if (!all_zero(base + s.offset + records, bases - records))
+            fail("section " + num(i) + " (step " + num(k) + ", depth " + num(d) +
+                 "): padding before the group bases is not zero");
     }
 }
 

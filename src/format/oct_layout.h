@@ -24,10 +24,10 @@
 //  256         +-------------------------------------------------------------+
 //              | zero padding to the next multiple of 64                      |
 //              +-------------------------------------------------------------+
-//              | step 0, depth 0:        InteriorNode<T>[1]       (the root)  |
-//              | step 0, depth 1:        InteriorNode<T>[n1]                  |
+//              | step 0, depth 0:        InteriorNode<T>[1], bases (the root) |
+//              | step 0, depth 1:        InteriorNode<T>[n1], group bases     |
 //              |   ...                                                        |
-//              | step 0, depth dmax-2:   InteriorNode<T>[n(dmax-2)]           |
+//              | step 0, depth dmax-2:   InteriorNode<T>[n(dmax-2)], bases    |
 //              | step 0, depth dmax-1:   packed caps (bytes), 8 zero bytes    |
 //              | step 1, depth 0 ...     (each section starts at the next     |
 //              |   ...                    multiple of 64; gaps are zero)      |
@@ -41,15 +41,24 @@
 //  with the table. So every byte of the file is covered by a checksum or must be zero, and a
 //  single flipped bit anywhere is detected (Verify::Full).
 //
-//  InteriorNode<T> record (formats 3 and 4, issue 19; s = sizeof(T)), no padding:
-//    +-------------+----------------+------------+----------+-----------+------------------------+
-//    | child_start | child_start_hi | child_mask | cap_bits | scalar[8] | bounds                 |
-//    | u32         | u16            | u8         | u8       | 8 T       | s == 1: min[8], max[8] |
-//    |             | (caps: byte    |            | (dmax-2  |           |   (8 T each, exact)    |
-//    |             |  offset bits   |            |  only)   |           | s > 1: lo, hi (T),     |
-//    |             |  32..47)       |            |          |           |   qmin[8], qmax[8] (u8)|
-//    +-------------+----------------+------------+----------+-----------+------------------------+
-//    32 bytes for 1-byte scalars, 44 for 2, 64 for 4, 104 for 8 (format 2: 24 s + 8).
+//  Interior section of depth d (format 5, issue 19): count InteriorNode<T> records, zero bytes up
+//  to a multiple of 8, then node_groups(count) = ceil(count / 128) u64 group bases:
+//    +-----------------------------+-----------+------------------------------------------+
+//    | InteriorNode<T>[count]      | 0..7 zero | u64 group_base[ceil(count / 128)]        |
+//    +-----------------------------+-----------+------------------------------------------+
+//  Node i's first child is group_base[i / 128] + its child_offset: a node index at depth d+1, or
+//  (d = dmax-2) a byte offset into the caps. Canonical: every node's first child is the sum of
+//  the children spans of the nodes before it, so child_offset of a group's first node is 0.
+//
+//  InteriorNode<T> record (s = sizeof(T)), no padding:
+//    +-----------+---------------------------------------+--------------+------------+----------+------+
+//    | scalar[8] | bounds: lo, hi (T), codes              | child_offset | child_mask | cap_bits | tail |
+//    | 8 T       | s == 1: codes[8]  (qmin | qmax << 4)   | u16          | u8         | u8       | s==8:|
+//    |           | s > 1:  qmin[8], qmax[8] (u8)          |              |            | (dmax-2  | u32  |
+//    |           |                                        |              |            |  only)   | zero |
+//    +-----------+---------------------------------------+--------------+------------+----------+------+
+//    22 bytes for 1-byte scalars, 40 for 2, 60 for 4, 104 for 8 (format 4: 32, 44, 64, 104; format 2:
+//    24 s + 8).
 //  Caps section: a byte array (record_bytes 1, count = its bytes). The caps of one depth dmax-2
 //  parent follow each other from its first_child() byte, each cap_bits bytes: 8 deltas of
 //  cap_bits bits, little-endian bit order, voxel k at bits [k b, (k+1) b) of the record, added to
@@ -71,7 +80,10 @@ inline constexpr char kMagic[8] = {'O', 'C', 'T', 'I', 'S', 'O', '\0', '\x1a'};
 /// 4: a stored interior child's scalar is the voxel at its lower corner, the level-of-detail
 /// lattice sample (issue 14), where format 3 kept the midpoint of its range; same layout, and
 /// version 3 files are refused with a message to convert again (`--lod` would misread them).
-inline constexpr uint32_t kFormatVersion = 4;
+/// 5: first children as group bases plus 16-bit offsets, 4-bit bounds codes for 1-byte scalars,
+/// the scalars first in the record (issue 19); version 4 files are refused with a message to
+/// convert again.
+inline constexpr uint32_t kFormatVersion = 5;
 inline constexpr uint32_t kEndianTag = 0x01020304u;   ///< reads back as 0x04030201 if swapped
 inline constexpr uint64_t kSectionAlign = 64;
 
@@ -111,9 +123,9 @@ struct SectionEntry {
     uint32_t kind;           //  0  SectionKind: Interior for depth <= dmax-2, Caps at dmax-1
     uint32_t step;           //  4  0 .. step_count-1
     uint32_t depth;          //  8  0 .. dmax-1
-    uint32_t record_bytes;   // 12  sizeof(InteriorNode<T>) or sizeof(Cap<T>)
+    uint32_t record_bytes;   // 12  sizeof(InteriorNode<T>), or 1 (caps: bytes)
     uint64_t offset;         // 16  multiple of 64
-    uint64_t bytes;          // 24  count * record_bytes
+    uint64_t bytes;          // 24  caps: count; interior: interior_section_bytes(count)
     uint64_t count;          // 32  records
     uint64_t checksum;       // 40  XXH3-64 of the section bytes
 };
@@ -139,10 +151,12 @@ static_assert(offsetof(SectionEntry, offset) == 16 && offsetof(SectionEntry, che
 template <typename T> constexpr bool record_layout_ok() {
     using N = InteriorNode<T>;
     constexpr size_t s = sizeof(T);
+    constexpr size_t bounds = 2 * s + (s == 1 ? 8 : 16);
     return std::is_trivially_copyable_v<N> && std::is_standard_layout_v<N> &&
-           sizeof(N) == 8 + 8 * s + (s == 1 ? 16 : 2 * s + 16) && offsetof(N, child_start_hi) == 4 &&
-           offsetof(N, child_mask) == 6 && offsetof(N, cap_bits) == 7 && offsetof(N, scalar) == 8 &&
-           offsetof(N, bounds) == 8 + 8 * s && alignof(N) <= kSectionAlign;
+           sizeof(N) == 8 * s + bounds + 4 + (s == 8 ? 4 : 0) && offsetof(N, scalar) == 0 &&
+           offsetof(N, bounds) == 8 * s && offsetof(N, child_offset) == 8 * s + bounds &&
+           offsetof(N, child_mask) == 8 * s + bounds + 2 && offsetof(N, cap_bits) == 8 * s + bounds + 3 &&
+           alignof(N) <= 8;
 }
 static_assert(record_layout_ok<uint8_t>() && record_layout_ok<int8_t>() && record_layout_ok<uint16_t>() &&
               record_layout_ok<int16_t>() && record_layout_ok<uint32_t>() && record_layout_ok<int32_t>() &&
@@ -151,9 +165,21 @@ static_assert(record_layout_ok<uint8_t>() && record_layout_ok<int8_t>() && recor
 /// Size of one record of each kind for a scalar of `scalar_bytes` bytes (1, 2, 4 or 8); the cap
 /// level is a byte array.
 inline constexpr uint64_t interior_record_bytes(uint64_t scalar_bytes) {
-    return 8 + 8 * scalar_bytes + (scalar_bytes == 1 ? 16 : 2 * scalar_bytes + 16);
+    return 10 * scalar_bytes + (scalar_bytes == 1 ? 12 : scalar_bytes == 8 ? 24 : 20);
 }
 inline constexpr uint64_t cap_record_bytes(uint64_t) { return 1; }
+static_assert(interior_record_bytes(1) == sizeof(InteriorNode<uint8_t>) &&
+              interior_record_bytes(2) == sizeof(InteriorNode<int16_t>) &&
+              interior_record_bytes(4) == sizeof(InteriorNode<float>) &&
+              interior_record_bytes(8) == sizeof(InteriorNode<double>));
+/// Where an interior section's group bases start, and its whole size, for `count` records
+/// (callers keep count * record far below 2^64, checked before use).
+inline constexpr uint64_t group_bases_offset(uint64_t count, uint64_t scalar_bytes) {
+    return (count * interior_record_bytes(scalar_bytes) + 7) & ~uint64_t(7);
+}
+inline constexpr uint64_t interior_section_bytes(uint64_t count, uint64_t scalar_bytes) {
+    return group_bases_offset(count, scalar_bytes) + 8 * node_groups(count);
+}
 
 /// Next multiple of 64 at or above `x`; callers keep x far below 2^64 (checked before use).
 inline constexpr uint64_t align_up(uint64_t x) { return (x + kSectionAlign - 1) & ~(kSectionAlign - 1); }

@@ -130,8 +130,9 @@ template <typename T> bool TouchValidator::check_section(uint64_t i, uint64_t lo
     const bool caps_below = s.depth == uint64_t(info_.dmax) - 2;
     const uint64_t below = next_count(i);
     const auto* nodes = reinterpret_cast<const InteriorNode<T>*>(view_ + s.offset);
+    const auto* bases = reinterpret_cast<const uint64_t*>(view_ + s.offset + group_bases_offset(s.count, sizeof(T)));
     for (uint64_t n = from; n < to; ++n)
-        if (node_defect(nodes[n], caps_below, below) != NodeDefect::none) {
+        if (node_defect(nodes[n], bases[n >> kNodeGroupShift], caps_below, below) != NodeDefect::none) {
             if (!failed_.exchange(true, std::memory_order_acq_rel)) {
                 bad_section_ = i;
                 bad_node_ = n;
@@ -153,8 +154,9 @@ std::optional<std::string> TouchValidator::failure() const {
     const bool caps_below = s.depth == uint64_t(info_.dmax) - 2;
     const std::string problem = dispatch_scalar_type(info_.type, [&](auto t) {
         using T = decltype(t);
-        return node_problem(reinterpret_cast<const InteriorNode<T>*>(view_ + s.offset)[bad_node_], caps_below,
-                            next_count(bad_section_));
+        const auto* bases = reinterpret_cast<const uint64_t*>(view_ + s.offset + group_bases_offset(s.count, sizeof(T)));
+        return node_problem(reinterpret_cast<const InteriorNode<T>*>(view_ + s.offset)[bad_node_],
+                            bases[bad_node_ >> kNodeGroupShift], caps_below, next_count(bad_section_));
     });
     return where(s.step, int(s.depth), info_.dmax) + ", node " + std::to_string(bad_node_) + ": " + problem;
 }

@@ -46,15 +46,15 @@ std::string hex(uint64_t v) {
 
 /// What one chunk of nodes at a depth found on its own; the stitch checks the boundaries.
 struct ChunkResult {
-    std::optional<uint64_t> first_parent;   ///< first node in the chunk with children
-    uint64_t first_start = 0;               ///< its child_start
+    uint64_t first_start = 0;               ///< the first child of the chunk's first node
     uint64_t children = 0;                  ///< what the chunk's children take below: nodes, or cap bytes
     uint64_t stored = 0;                    ///< sum of popcount(child_mask) over the chunk
     uint64_t leaves = 0;                    ///< sum of 8 - popcount
-    std::optional<uint64_t> bad_node;       ///< first node failing a local check
+    std::optional<uint64_t> bad_node;       ///< first node failing a check
     std::string problem;
 };
 
+/// A multiple of kNodeGroup, so that no group straddles two chunks.
 constexpr uint64_t kChunk = 1u << 15;
 
 }  // namespace
@@ -64,22 +64,25 @@ std::string where(uint32_t step, int depth, int dmax) {
            (depth == dmax - 1 ? " (caps)" : " (interior nodes)");
 }
 
-// The node's own fields (formats 3 and 4, octree.h): the cap width where caps lie below, zero high
-// offset bits and zero width elsewhere, ordered finite bounds, lattice samples inside their ranges;
-// then its children inside the level below. Allocation-free: the touch validator runs it in a
-// fault handler (touch_validation.h); node_problem() words the same checks for a message.
-template <typename T> NodeDefect node_defect(const InteriorNode<T>& n, bool caps_below, uint64_t next_count) noexcept {
+// The node's own fields (format 5, octree.h): the cap width where caps lie below and zero width
+// elsewhere, a zero tail, ordered finite bounds, lattice samples inside their ranges; then its
+// children inside the level below. Allocation-free: the touch validator runs it in a fault
+// handler (touch_validation.h); node_problem() words the same checks for a message.
+template <typename T>
+NodeDefect node_defect(const InteriorNode<T>& n, uint64_t group_base, bool caps_below, uint64_t next_count) noexcept {
     if (caps_below) {
         if (n.cap_bits != kWholeCapBits<T> && n.cap_bits > kMaxDeltaBits<T>) return NodeDefect::cap_bits;
-    } else if (n.cap_bits != 0 || n.child_start_hi != 0) {
+    } else if (n.cap_bits != 0) {
         return NodeDefect::high_fields;
     }
-    if constexpr (sizeof(T) > 1) {
+    if constexpr (sizeof(T) == 8)
+        if (n.tail.zero != 0) return NodeDefect::tail;
+    {
         const double lo = double(n.bounds.lo), hi = double(n.bounds.hi);
         if (!(std::isfinite(lo) && std::isfinite(hi) && lo <= hi)) return NodeDefect::bounds;
     }
-    // Format 4: a stored interior child's scalar is the voxel at its lower corner, a corner of
-    // one of its data cells, so it lies in the child's range whenever that range is not empty.
+    // A stored interior child's scalar is the voxel at its lower corner (format 4 on), a corner
+    // of one of its data cells, so it lies in the child's range whenever that range is not empty.
     // Level of detail traces it; outside the range it would draw a surface the culling denies.
     if (!caps_below)
         for (int c = 0; c < 8; ++c) {
@@ -87,26 +90,30 @@ template <typename T> NodeDefect node_defect(const InteriorNode<T>& n, bool caps
             const double v = double(n.scalar[c]);
             if (!(n.bounds.lower(c) <= v && v <= n.bounds.upper(c))) return NodeDefect::lattice_sample;
         }
-    // Compared without adding: first_child() is at most 2^48 and the span at most 8 x 64.
-    const uint64_t start = n.first_child(), span = n.children_span(caps_below);
-    if (start > next_count || span > next_count - start) return NodeDefect::children_past_end;
+    // Compared without wrapping: the base comes from the file, the offset is 16 bits and the span
+    // at most 8 x 64.
+    const uint64_t span = n.children_span(caps_below);
+    if (group_base > next_count || n.child_offset > next_count - group_base) return NodeDefect::children_past_end;
+    const uint64_t start = group_base + n.child_offset;
+    if (span > next_count - start) return NodeDefect::children_past_end;
     return NodeDefect::none;
 }
 
-template <typename T> std::string node_problem(const InteriorNode<T>& n, bool caps_below, uint64_t next_count) {
-    switch (node_defect(n, caps_below, next_count)) {
+template <typename T>
+std::string node_problem(const InteriorNode<T>& n, uint64_t group_base, bool caps_below, uint64_t next_count) {
+    switch (node_defect(n, group_base, caps_below, next_count)) {
     case NodeDefect::none: return {};
     case NodeDefect::cap_bits:
         return "cap_bits out of range (expected 0 .. " + std::to_string(kMaxDeltaBits<T>) + " or " +
                std::to_string(kWholeCapBits<T>) + ", found " + std::to_string(n.cap_bits) + ")";
     case NodeDefect::high_fields:
-        return "cap_bits and child_start_hi must be zero above the cap parents (found " + std::to_string(n.cap_bits) +
-               " and " + std::to_string(n.child_start_hi) + ")";
+        return "cap_bits must be zero above the cap parents (found " + std::to_string(n.cap_bits) + ")";
+    case NodeDefect::tail:
+        if constexpr (sizeof(T) == 8) return "the record's last 4 bytes must be zero (found " + std::to_string(n.tail.zero) + ")";
+        return "the record's tail must be zero";
     case NodeDefect::bounds:
-        if constexpr (sizeof(T) > 1)
-            return "bounds range is not finite and ordered (found lo " + std::to_string(double(n.bounds.lo)) + ", hi " +
-                   std::to_string(double(n.bounds.hi)) + ")";
-        return "bounds range is not finite and ordered";
+        return "bounds range is not finite and ordered (found lo " + std::to_string(double(n.bounds.lo)) + ", hi " +
+               std::to_string(double(n.bounds.hi)) + ")";
     case NodeDefect::lattice_sample:
         for (int c = 0; c < 8; ++c) {
             if (!((n.child_mask >> c) & 1u) || n.bounds.empty(c)) continue;
@@ -118,11 +125,14 @@ template <typename T> std::string node_problem(const InteriorNode<T>& n, bool ca
         }
         return "a lattice sample lies outside its range";
     case NodeDefect::children_past_end: {
-        const uint64_t start = n.first_child(), span = n.children_span(caps_below);
-        const char* what = caps_below ? "first_child + popcount(child_mask) x cap_bits" : "child_start + popcount(child_mask)";
+        const uint64_t span = n.children_span(caps_below);
+        const char* what = caps_below ? "group base + child_offset + popcount(child_mask) x cap_bits"
+                                      : "group base + child_offset + popcount(child_mask)";
+        // The terms, not their sum: a hostile base near 2^64 would wrap it.
         return std::string(what) + " runs past the " + std::to_string(next_count) + " " +
                (caps_below ? "bytes of caps" : "nodes") + " below (expected <= " + std::to_string(next_count) +
-               ", found " + std::to_string(start) + " + " + std::to_string(span) + " = " + std::to_string(start + span) + ")";
+               ", found " + std::to_string(group_base) + " + " + std::to_string(n.child_offset) + " + " +
+               std::to_string(span) + ")";
     }
     }
     return {};
@@ -131,35 +141,37 @@ template <typename T> std::string node_problem(const InteriorNode<T>& n, bool ca
 namespace {
 
 template <typename T>
-ChunkResult check_chunk(const InteriorNode<T>* nodes, uint64_t begin, uint64_t end, uint64_t next_count, bool caps_below) {
+ChunkResult check_chunk(const InteriorNode<T>* nodes, const uint64_t* bases, uint64_t begin, uint64_t end,
+                        uint64_t next_count, bool caps_below) {
     ChunkResult r;
-    uint64_t expected_start = 0;   // where the next node with children must start (after the first)
+    uint64_t expected_start = 0;   // where the next node's children must start (after the first)
     for (uint64_t i = begin; i < end; ++i) {
         const InteriorNode<T>& n = nodes[i];
+        const uint64_t base = bases[i >> kNodeGroupShift];
         const uint64_t pc = uint64_t(std::popcount(unsigned(n.child_mask)));
         const uint64_t span = n.children_span(caps_below);   // bytes of caps, or nodes
-        const uint64_t start = n.first_child();
         auto fail = [&](std::string problem) {
             r.bad_node = i;
             r.problem = std::move(problem);
         };
-        if (node_defect(n, caps_below, next_count) != NodeDefect::none) {
-            fail(node_problem(n, caps_below, next_count));
+        if (node_defect(n, base, caps_below, next_count) != NodeDefect::none) {
+            fail(node_problem(n, base, caps_below, next_count));
             return r;
         }
-        if (pc != 0) {
-            if (!r.first_parent) {
-                r.first_parent = i;
-                r.first_start = start;
-            } else if (start != expected_start) {
-                fail(std::string(start < expected_start ? "children overlap those of an earlier node"
-                                                        : "children leave a gap after those of an earlier node") +
-                     " (expected child_start " + std::to_string(expected_start) + ", found " + std::to_string(start) +
-                     ")");
-                return r;
-            }
-            expected_start = start + span;
+        if ((i & (kNodeGroup - 1)) == 0 && n.child_offset != 0) {
+            fail("the first node of a group must have child_offset 0 (found " + std::to_string(n.child_offset) + ")");
+            return r;
         }
+        const uint64_t start = base + n.child_offset;   // <= next_count: node_defect
+        if (i == begin) {
+            r.first_start = start;
+        } else if (start != expected_start) {
+            fail(std::string(start < expected_start ? "children overlap those of an earlier node"
+                                                    : "children leave a gap after those of an earlier node") +
+                 " (expected first child " + std::to_string(expected_start) + ", found " + std::to_string(start) + ")");
+            return r;
+        }
+        expected_start = start + span;
         r.children += span;
         r.stored += pc;
         r.leaves += 8 - pc;
@@ -187,8 +199,8 @@ template <typename T> StepSizes validate_counts(const std::string& subject, cons
     if (a.node_count[0] != 1)
         throw Error(subject, where(step, 0, dmax) + ": the root level must hold exactly one node (expected 1, found " +
                                  std::to_string(a.node_count[0]) + ")");
-    // Node indices are 32-bit (child_start, child_index()), so no depth may hold more than 2^32;
-    // caps are found by 48-bit byte offsets.
+    // Node indices are 32-bit (Octree::child_index, the traversal's parent traces), so no depth
+    // may hold more than 2^32; the cap level holds at most 2^48 bytes.
     constexpr uint64_t kMaxPerDepth = uint64_t(1) << 32;
     for (int d = 1; d + 1 < dmax; ++d) {
         const uint64_t n = a.node_count[size_t(d)];
@@ -209,10 +221,10 @@ template <typename T> StepSizes validate_counts(const std::string& subject, cons
     sizes.scalar_leaves_per_depth.assign(size_t(dmax), 0);
     for (int d = 0; d <= dmax - 2; ++d) {
         const uint64_t count = a.node_count[size_t(d)];
-        if (count != 0 && a.nodes[size_t(d)] == nullptr)
+        if (count != 0 && (a.nodes[size_t(d)] == nullptr || a.group_base[size_t(d)] == nullptr))
             throw Error(subject, where(step, d, dmax) + ": " + std::to_string(count) + " nodes but no data");
         sizes.nodes_per_depth[size_t(d)] = count;
-        sizes.interior_bytes += count * sizeof(InteriorNode<T>);
+        sizes.interior_bytes += interior_level_bytes<T>(count);
         sizes.minmax_bytes += count * sizeof(ChildBounds<T>);
     }
     sizes.cap_bytes = a.cap_bytes;
@@ -236,18 +248,20 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
         tbb::parallel_for(uint64_t(0), n_chunks, [&](uint64_t c) {
             const uint64_t begin = c * kChunk;
             const uint64_t end = std::min(count, begin + kChunk);
-            chunks[c] = check_chunk(nodes, begin, end, next_count, next_is_caps);
+            chunks[c] = check_chunk(nodes, a.group_base[size_t(d)], begin, end, next_count, next_is_caps);
         });
 
         // 3. Stitch: each chunk's first children start where the previous chunks' children end;
         // the earliest failing node (local or boundary) is the one reported.
         uint64_t covered = 0, leaves = 0, stored = 0;
-        for (const ChunkResult& r : chunks) {
-            if (r.first_parent && r.first_start != covered && (!r.bad_node || *r.first_parent < *r.bad_node))
-                throw Error(subject, where(step, d, dmax) + ", node " + std::to_string(*r.first_parent) + ": " +
+        for (uint64_t c = 0; c < n_chunks; ++c) {
+            const ChunkResult& r = chunks[c];
+            const uint64_t first = c * kChunk;
+            if (r.first_start != covered && (!r.bad_node || first < *r.bad_node))
+                throw Error(subject, where(step, d, dmax) + ", node " + std::to_string(first) + ": " +
                                          (r.first_start < covered ? "children overlap those of an earlier node"
                                                                   : "children leave a gap after those of an earlier node") +
-                                         " (expected child_start " + std::to_string(covered) + ", found " +
+                                         " (expected first child " + std::to_string(covered) + ", found " +
                                          std::to_string(r.first_start) + ")");
             if (r.bad_node) throw Error(subject, where(step, d, dmax) + ", node " + std::to_string(*r.bad_node) + ": " + r.problem);
             covered += r.children;
@@ -267,8 +281,8 @@ template <typename T> StepSizes validate_tree(const std::string& subject, const 
 #define OCTISO_INSTANTIATE(T)                                                                                 \
     template StepSizes validate_tree<T>(const std::string&, const OctreeArrays<T>&, uint32_t);                \
     template StepSizes validate_counts<T>(const std::string&, const OctreeArrays<T>&, uint32_t);              \
-    template NodeDefect node_defect<T>(const InteriorNode<T>&, bool, uint64_t) noexcept;                     \
-    template std::string node_problem<T>(const InteriorNode<T>&, bool, uint64_t);
+    template NodeDefect node_defect<T>(const InteriorNode<T>&, uint64_t, bool, uint64_t) noexcept;           \
+    template std::string node_problem<T>(const InteriorNode<T>&, uint64_t, bool, uint64_t);
 OCTISO_FOR_EACH_SCALAR_TYPE(OCTISO_INSTANTIATE)
 #undef OCTISO_INSTANTIATE
 

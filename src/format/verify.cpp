@@ -93,7 +93,7 @@ template <typename T> struct Walker {
                     lie(d, i, c, "scalar " + std::to_string(double(node.scalar[c])) + " is not the voxel at its corner (" +
                                      std::to_string(double(want)) + ")");
             }
-            walk(d + 1, node.child_index(c), lo);
+            walk(d + 1, tree.child_index(d, i, node, c), lo);
         }
     }
 };

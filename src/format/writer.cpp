@@ -52,8 +52,10 @@ struct OctWriter::Impl {
         static constexpr std::byte kZeros[format::kSectionAlign] = {};
         write(kZeros, format::align_up(pos) - pos);
     }
+    /// A section from memory: `count` records, and for an interior level its group bases after
+    /// them (oct_layout.h); the checksum runs over the bytes as they are written.
     void add_section(format::SectionKind kind, uint32_t step, int depth, uint32_t record_bytes, const void* data,
-                     uint64_t count) {
+                     uint64_t count, const uint64_t* group_bases = nullptr) {
         pad_to_alignment();
         SectionEntry s{};
         s.kind = uint32_t(kind);
@@ -62,9 +64,20 @@ struct OctWriter::Impl {
         s.record_bytes = record_bytes;
         s.offset = pos;
         s.count = count;
-        s.bytes = count * record_bytes;   // the arrays exist in memory, so this cannot overflow
-        s.checksum = format::checksum(data, size_t(s.bytes));
-        write(data, s.bytes);
+        const uint64_t records = count * record_bytes;   // the arrays exist in memory, so this cannot overflow
+        format::ChecksumStream sum;
+        sum.update(data, size_t(records));
+        write(data, records);
+        if (kind == format::SectionKind::Interior) {
+            static constexpr uint8_t kZero[8] = {};
+            const uint64_t pad = (8 - records % 8) % 8, bases = 8 * node_groups(count);
+            sum.update(kZero, size_t(pad));
+            write(kZero, pad);
+            sum.update(group_bases, size_t(bases));
+            write(group_bases, bases);
+        }
+        s.bytes = pos - s.offset;
+        s.checksum = sum.digest();
         table.push_back(s);
     }
 };
@@ -123,7 +136,7 @@ template <typename T> void OctWriter::add_step(const Octree<T>& octree) {
     const OctreeArrays<T>& a = octree.arrays();
     for (int d = 0; d + 1 < a.dmax; ++d)
         m.add_section(format::SectionKind::Interior, step, d, uint32_t(sizeof(InteriorNode<T>)), a.nodes[size_t(d)],
-                      a.node_count[size_t(d)]);
+                      a.node_count[size_t(d)], a.group_base[size_t(d)]);
     m.add_section(format::SectionKind::Caps, step, a.dmax - 1, 1, a.caps, a.cap_bytes + kCapReadSlack);
     m.info.step_count = step + 1;
 }
@@ -151,7 +164,7 @@ void OctWriter::begin_section(int depth, uint64_t count) {
     e.record_bytes = uint32_t(record);
     e.offset = m.pos;
     e.count = count;
-    e.bytes = count * record;
+    e.bytes = caps ? count * record : format::interior_section_bytes(count, scalar);   // records, then group bases
     m.open_written = 0;
     m.open_checksum.reset();
     m.open_depth = depth;

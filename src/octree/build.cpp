@@ -3,11 +3,11 @@
 // Plan: 1. condition the input (prepare.h); 2. cut the tree at a split depth k into up to 8^k
 // subtrees ("pieces") and build each one depth-first in its own Sink, in parallel; 3. build the
 // few nodes above depth k serially from the pieces' root summaries; 4. concatenate each depth's
-// arrays, offsetting child_start by the children the earlier pieces contributed.
+// arrays and place every node's children (child_groups.h: a prefix sum of the children spans).
 //
 // Why depth-first post-order works: a node is appended to its depth's array when its own children
 // are complete, so the 8 children of any node are appended consecutively at depth d+1, which is
-// exactly what child_start + popcount indexing needs. A child is appended only if it is not a
+// exactly what first child + popcount indexing needs. A child is appended only if it is not a
 // scalar leaf, and a node merges into a leaf only if all its children are leaves, so a merge never
 // leaves orphans behind.
 //
@@ -30,6 +30,7 @@
 
 #include "octiso/build.h"
 #include "octiso/error.h"
+#include "octree/child_groups.h"
 #include "octree/prepare.h"
 #include "octree/piece_builder.h"
 #include "octree/summary.h"
@@ -46,6 +47,7 @@ template <typename T> Octree<T> OctreeData<T>::view() const {
         a.nodes[d] = nodes[d].data.get();
         a.node_count[d] = nodes[d].size;
     }
+    for (size_t d = 0; d < group_bases.size(); ++d) a.group_base[d] = group_bases[d].data.get();
     a.caps = caps.data.get();
     a.cap_bytes = cap_bytes;
     a.cap_count = cap_count;
@@ -114,32 +116,27 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
     phase_done(phases.pieces);
     phases.pieces_busy = double(pieces_busy_ns.load()) * 1e-9;
 
-    // 2. The top: the same descent, taking each depth-k summary from its piece. A depth-(k-1)
-    //    node's child_start counts the piece roots stored before it.
+    // 2. The top: the same descent, taking each depth-k summary from its piece.
     Sink<T> top(dmax);
     size_t next_piece = 0;
-    uint64_t stored_at_k = 0;
     auto descend = [&](auto&& self, int d, Coord o) -> Summary<T> {
         if (builder.outside(o)) return Builder<T>::padding();
         if (d == k) {
-            const Summary<T>& s = roots[next_piece++];
-            if (!s.is_leaf) ++stored_at_k;
-            return s;
+            return roots[next_piece++];
         }
         Summary<T> ch[8];
-        const uint64_t start = d + 1 == k ? stored_at_k : top.nodes[size_t(d + 1)].size();
         for (int c = 0; c < 8; ++c) ch[c] = self(self, d + 1, Builder<T>::child_origin(o, c, builder.child_bit(d)));
-        return builder.combine(d, ch, start, top);
+        return builder.combine(d, ch, top);
     };
     if (k > 0) descend(descend, 0, Coord{});
-    // The top must consume every piece in the order they were cut, or child_start at depth k-1
-    // would point at another piece's root.
+    // The top must consume every piece in the order they were cut, or a depth-(k-1) node's
+    // children would be another piece's roots.
     OCTISO_CHECK(k == 0 || next_piece == origins.size(), next_piece, " of ", origins.size(), " pieces consumed");
     phase_done(phases.top);
 
     // 3. Concatenate depth by depth. Depths below k come from `top` alone. The pieces of a depth
     //    are copied in parallel, in batches of 16 pieces or two per thread (whichever is more):
-    //    each piece's place and child offset are prefix sums, so the copies are independent
+    //    each piece's place is a prefix sum, so the copies are independent
     //    (issue 12: serial, the copy and the trims were 0.044 s of a 1.27 s 1-thread build of
     //    plume 512^3, an Amdahl bound of 66 % at 16 threads; BENCHMARKS.md "Many-core"). Freed piece
     //    memory is handed back as the copy goes, so peak memory stays near input + output.
@@ -172,49 +169,41 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
         }
     };
     out.nodes.resize(size_t(dmax - 1));
+    out.group_bases.resize(size_t(dmax - 1));
     out.stats.nodes_per_depth.assign(size_t(dmax), 0);
     out.stats.scalar_leaves_per_depth.assign(size_t(dmax), 0);
     for (int d = 0; d <= dmax - 2; ++d) {
         std::vector<Sink<T>*> parts;
         if (d < k) parts.push_back(&top);
         else for (auto& s : sinks) parts.push_back(&s);
-        // Where each part's nodes go, and how many children the parts before it contributed at
-        // depth d+1 (read before this depth's moves free the depth-d arrays; depth d+1 is intact).
-        const bool caps_below = d + 1 == dmax - 1;
-        std::vector<uint64_t> at(parts.size()), child_offset(parts.size());
-        uint64_t total = 0, children = 0;
+        std::vector<uint64_t> at(parts.size());
+        uint64_t total = 0;
         for (size_t i = 0; i < parts.size(); ++i) {
             at[i] = total;
-            child_offset[i] = d >= k ? children : 0;
             total += parts[i]->nodes[size_t(d)].size();
-            children += caps_below ? parts[i]->caps.size() : parts[i]->nodes[size_t(d + 1)].size();
             out.stats.scalar_leaves_per_depth[size_t(d)] += parts[i]->leaves[size_t(d)];
         }
         // Children at depth d+1, as they will be concatenated.
+        const bool caps_below = d + 1 == dmax - 1;
         uint64_t next_total = 0;
         if (caps_below) for (auto& s : sinks) next_total += s.caps.size();
         else if (d + 1 < k) next_total = top.nodes[size_t(d + 1)].size();
         else for (auto& s : sinks) next_total += s.nodes[size_t(d + 1)].size();
         // Interior children are 32-bit node indices, caps 48-bit byte offsets (octree.h).
-        const uint64_t limit = caps_below ? kMaxCapByteOffset : uint64_t(1) << 32;
+        if (next_total > (caps_below ? kMaxCapByteOffset : uint64_t(1) << 32))
+            throw Error(options.source_name, caps_below ? "octree too large: more than 2^48 bytes of caps"
+                                                        : "octree too large: more than 2^32 nodes at depth " +
+                                                              std::to_string(d + 1) + " (32-bit child indices)");
         out.nodes[size_t(d)] = UninitArray<InteriorNode<T>>::make(total);
         in_batches(parts.size(), [&](size_t i) { return parts[i]->nodes[size_t(d)].size() * sizeof(InteriorNode<T>); },
                    [&](size_t i) {
-            auto& v = parts[i]->nodes[size_t(d)];
-            for (auto& n : v) {
-                const uint64_t span = n.children_span(caps_below);
-                const uint64_t global = n.first_child() + child_offset[i];
-                if (global + span > limit)
-                    throw Error(options.source_name, caps_below ? "octree too large: more than 2^48 bytes of caps"
-                                                                : "octree too large: more than 2^32 nodes at depth " +
-                                                                      std::to_string(d + 1) + " (32-bit child indices)");
-                n.set_first_child(global);
-                OCTISO_CHECK(global + span <= next_total, "depth ", d, ": children from ", global, " past ", next_total,
-                             " at depth ", d + 1);
-            }
             uint64_t place = at[i];
-            move_into(out.nodes[size_t(d)], place, v);
+            move_into(out.nodes[size_t(d)], place, parts[i]->nodes[size_t(d)]);
         });
+        out.group_bases[size_t(d)] = UninitArray<uint64_t>::make(node_groups(total));
+        const uint64_t children = detail::place_children(out.nodes[size_t(d)].data.get(), total, caps_below,
+                                                         out.group_bases[size_t(d)].data.get());
+        OCTISO_CHECK(children == next_total, "depth ", d, ": children for ", children, " of ", next_total, " at depth ", d + 1);
         out.stats.nodes_per_depth[size_t(d)] = total;
     }
     uint64_t n_bytes = 0, n_caps = 0;
@@ -235,8 +224,10 @@ template <typename T> OctreeData<T> build_impl(const VolumeView<T>& input, const
     out.cap_count = n_caps;
     out.stats.nodes_per_depth[size_t(dmax - 1)] = n_caps;
 
-    for (int d = 0; d <= dmax - 2; ++d) out.stats.interior_bytes += out.nodes[size_t(d)].size * sizeof(InteriorNode<T>);
-    out.stats.minmax_bytes = out.stats.interior_bytes / sizeof(InteriorNode<T>) * sizeof(ChildBounds<T>);
+    for (int d = 0; d <= dmax - 2; ++d) {
+        out.stats.interior_bytes += interior_level_bytes<T>(out.nodes[size_t(d)].size);
+        out.stats.minmax_bytes += out.nodes[size_t(d)].size * sizeof(ChildBounds<T>);
+    }
     out.stats.cap_bytes = n_bytes;
     out.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;

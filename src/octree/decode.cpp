@@ -59,8 +59,8 @@ public:
         for (int ch = 0; ch < 8; ++ch) {
             const Coord cc = child_corner(c, ch, half);
             if (n.is_scalar_leaf(ch)) fill_block(cc, half, n.scalar[ch]);
-            else if (depth + 1 == o_.cap_depth()) fill_cap(cc, o_.cap(n, ch));
-            else fill_node(depth + 1, n.child_index(ch), cc);
+            else if (depth + 1 == o_.cap_depth()) fill_cap(cc, o_.cap(index, n, ch));
+            else fill_node(depth + 1, o_.child_index(depth, index, n, ch), cc);
         }
     }
 
@@ -109,7 +109,7 @@ template <typename T> void decode_layers(const Octree<T>& octree, uint32_t z0, u
                 const Coord cc = Decoder<T>::child_corner(p.corner, ch, half);
                 if (!dec.wanted(cc, half)) continue;
                 if (n.is_scalar_leaf(ch)) next.push_back({-1, 0, n.scalar[ch], cc, half});
-                else next.push_back({d + 1, n.child_index(ch), T{}, cc, half});
+                else next.push_back({d + 1, octree.child_index(d, p.index, n, ch), T{}, cc, half});
             }
         }
         pieces.swap(next);

@@ -69,21 +69,18 @@ public:
         if (outside(o)) return padding();
         if (d == dmax_ - 2) return build_cap_parent(o, sink);
         Summary<T> ch[8];
-        const uint64_t start = sink.nodes[size_t(d + 1)].size();
         const uint32_t half = child_bit(d);
         for (int c = 0; c < 8; ++c) ch[c] = build(d + 1, child_origin(o, c, half), sink);
-        return combine(d, ch, start, sink);
+        return combine(d, ch, sink);
     }
 
     /// Folds 8 child summaries into a leaf, or stores an interior node at depth d.
-    /// `start` is the index the first stored child got at depth d+1 (local to the sink; for a cap
-    /// parent the byte offset of its first cap), `caps` a cap parent's `n_caps` caps in order.
-    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, Sink<T>& sink, const Cap<T>* caps = nullptr,
-                       int n_caps = 0) const {
+    /// `caps` are a cap parent's `n_caps` caps in order.
+    Summary<T> combine(int d, const Summary<T>* ch, Sink<T>& sink, const Cap<T>* caps = nullptr, int n_caps = 0) const {
         Summary<T> out;
         InteriorNode<T> n;
         auto merge = [this](T lo, T hi, T& rep) { return mergeable(lo, hi, rep); };
-        if (fold_children(d, ch, start, merge, out, n)) return out;
+        if (fold_children(d, ch, merge, out, n)) return out;
         if (n_caps) {
             append_caps(n, caps, n_caps, sink.caps);
             sink.cap_count += uint64_t(n_caps);
@@ -103,11 +100,10 @@ public:
         Summary<T> ch[8];
         Cap<T> caps[8];
         int n_caps = 0;
-        const uint64_t start = sink.caps.size();
         cap_parent_children(
             L, o, dims_, [this](T lo, T hi, T& rep) { return mergeable(lo, hi, rep); },
             [this](T& lo, T& hi) { widen(lo, hi); }, [&](const Cap<T>& cap) { caps[n_caps++] = cap; }, ch);
-        return combine(dmax_ - 2, ch, start, sink, caps, n_caps);
+        return combine(dmax_ - 2, ch, sink, caps, n_caps);
     }
 
     const VolumeView<T> v_;

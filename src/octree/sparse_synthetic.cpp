@@ -5,6 +5,7 @@
 // voxels miss every blob support is uniform, so it is a leaf without descending; its cell range
 // is the background plus the blob values on its forward layer, enumerated from the supports.
 #include "octree/sparse_synthetic.h"
+#include "octree/child_groups.h"
 #include "octree/summary.h"
 
 #include <algorithm>
@@ -94,28 +95,31 @@ public:
 
     OctreeData<T> run() {
         build(0, Coord{});
-        // Every stored node's children must lie in the next depth's array (the loader would refuse
-        // the file; an in-memory octree would be traversed out of bounds).
-        for (int d = 0; d <= dmax_ - 2; ++d) {
-            const bool caps_below = d + 1 == dmax_ - 1;
-            const uint64_t next = caps_below ? caps_.size() : nodes_[size_t(d + 1)].size();
-            for (const InteriorNode<T>& n : nodes_[size_t(d)]) {
-                OCTISO_CHECK(n.first_child() + n.children_span(caps_below) <= next, "depth ", d, ": children from ", n.first_child(), " past ",
-                             next, " at depth ", d + 1);
-            }
-        }
         OctreeData<T> out;
         out.dims = dims_;
         out.dmax = dmax_;
         out.nodes.resize(size_t(dmax_ - 1));
+        out.group_bases.resize(size_t(dmax_ - 1));
         out.stats.nodes_per_depth.assign(size_t(dmax_), 0);
         out.stats.scalar_leaves_per_depth = leaves_;
         for (int d = 0; d <= dmax_ - 2; ++d) {
             const auto& v = nodes_[size_t(d)];
+            const bool caps_below = d + 1 == dmax_ - 1;
+            const uint64_t next = caps_below ? caps_.size() : nodes_[size_t(d + 1)].size();
+            if (next > (caps_below ? kMaxCapByteOffset : uint64_t(1) << 32))
+                throw Error("sparse-spheres", caps_below ? "octree too large: more than 2^48 bytes of caps"
+                                                         : "octree too large: more than 2^32 nodes at depth " + std::to_string(d + 1));
             out.nodes[size_t(d)] = UninitArray<InteriorNode<T>>::make(v.size());
             std::copy(v.begin(), v.end(), out.nodes[size_t(d)].data.get());
+            out.group_bases[size_t(d)] = UninitArray<uint64_t>::make(node_groups(v.size()));
+            // Every stored node's children must lie in the next depth's array (the loader would
+            // refuse the file; an in-memory octree would be traversed out of bounds).
+            const uint64_t children = detail::place_children(out.nodes[size_t(d)].data.get(), v.size(), caps_below,
+                                                             out.group_bases[size_t(d)].data.get());
+            OCTISO_CHECK(children == next, "depth ", d, ": children for ", children, " of ", next, " at depth ", d + 1);
             out.stats.nodes_per_depth[size_t(d)] = v.size();
-            out.stats.interior_bytes += v.size() * sizeof(InteriorNode<T>);
+            out.stats.interior_bytes += interior_level_bytes<T>(v.size());
+            out.stats.minmax_bytes += v.size() * sizeof(ChildBounds<T>);
         }
         out.caps = UninitArray<uint8_t>::make(caps_.size() + kCapReadSlack);
         std::copy(caps_.begin(), caps_.end(), out.caps.data.get());
@@ -123,7 +127,6 @@ public:
         out.cap_count = cap_count_;
         out.cap_bytes = caps_.size();
         out.stats.nodes_per_depth[size_t(dmax_ - 1)] = cap_count_;
-        out.stats.minmax_bytes = out.stats.interior_bytes / sizeof(InteriorNode<T>) * sizeof(ChildBounds<T>);
         out.stats.cap_bytes = caps_.size();
         return out;
     }
@@ -196,21 +199,16 @@ private:
         if (d > 0 && !touches_blob(voxel_box(o, side))) return uniform_leaf(o, side);
         if (d == dmax_ - 2) return build_cap_parent(o);
         Summary<T> ch[8];
-        const uint64_t start = nodes_[size_t(d + 1)].size();
         for (int c = 0; c < 8; ++c) ch[c] = build(d + 1, child_origin(o, c, child_bit(d)));
-        return combine(d, ch, start);
+        return combine(d, ch);
     }
 
     // The same rules as build_octree with tolerance 0 (summary.h); the tests compare the arrays
     // node for node.
-    Summary<T> combine(int d, const Summary<T>* ch, uint64_t start, const Cap<T>* caps = nullptr, int n_caps = 0) {
-        const bool caps_below = d + 1 == dmax_ - 1;
-        if (start > (caps_below ? kMaxCapByteOffset : uint64_t(std::numeric_limits<uint32_t>::max())))
-            throw Error("sparse-spheres", caps_below ? "octree too large: more than 2^48 bytes of caps"
-                                                     : "octree too large: more than 2^32 nodes at depth " + std::to_string(d + 1));
+    Summary<T> combine(int d, const Summary<T>* ch, const Cap<T>* caps = nullptr, int n_caps = 0) {
         Summary<T> out;
         InteriorNode<T> n;
-        if (detail::fold_children(d, ch, start, &SparseBuilder::mergeable, out, n)) return out;
+        if (detail::fold_children(d, ch, &SparseBuilder::mergeable, out, n)) return out;
         if (n_caps) {
             detail::append_caps(n, caps, n_caps, caps_);
             cap_count_ += uint64_t(n_caps);
@@ -226,10 +224,9 @@ private:
         Summary<T> ch[8];
         Cap<T> caps[8];
         int n_caps = 0;
-        const uint64_t start = caps_.size();
         detail::cap_parent_children(
             L, o, dims_, &SparseBuilder::mergeable, [](T&, T&) {}, [&](const Cap<T>& cap) { caps[n_caps++] = cap; }, ch);
-        return combine(dmax_ - 2, ch, start, caps, n_caps);
+        return combine(dmax_ - 2, ch, caps, n_caps);
     }
 
     const SparseSpheres& f_;

@@ -36,12 +36,11 @@ inline Coord child_origin(Coord o, int c, uint32_t half) {
 
 /// Folds the 8 child summaries of a node at depth d. Returns true with `out` = the merged scalar
 /// leaf when all children are leaves whose data ranges `mergeable(lo, hi, rep)` accepts (never at
-/// d == 0: the root is always stored). Otherwise fills `node` (first child `start`, local to the
-/// caller's arrays; bounds packed, pack.h; a cap parent's caps are packed by pack_caps after) and
-/// `out` with the stored node's summary, and returns false.
+/// d == 0: the root is always stored). Otherwise fills `node` (bounds packed, pack.h; a cap
+/// parent's caps are packed by pack_caps after; its children are placed when its level is
+/// complete, child_groups.h) and `out` with the stored node's summary, and returns false.
 template <typename T, class Mergeable>
-bool fold_children(int d, const Summary<T>* ch, uint64_t start, const Mergeable& mergeable, Summary<T>& out,
-                   InteriorNode<T>& node) {
+bool fold_children(int d, const Summary<T>* ch, const Mergeable& mergeable, Summary<T>& out, InteriorNode<T>& node) {
     bool all_leaves = true, any_data = false;
     T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
     T cmin = std::numeric_limits<T>::max(), cmax = std::numeric_limits<T>::lowest();
@@ -79,7 +78,6 @@ bool fold_children(int d, const Summary<T>* ch, uint64_t start, const Mergeable&
     }
     node.child_mask = mask;
     node.bounds = pack_bounds(mn, mx);
-    node.set_first_child(start);   // local; the caller offsets and range-checks it
     // The lower corner voxel lies in child 0, which holds data whenever the node does.
     out = {any_data ? ch[0].scalar : T{}, cmin, cmax, lo, hi, false, !any_data};
     return false;

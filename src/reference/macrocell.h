@@ -104,7 +104,7 @@ template <typename T> struct OctreeCorners {
                 return;
             }
             if (d == cap_parents) {
-                const CapRef<T> cap = tree.cap(n, c);
+                const CapRef<T> cap = tree.cap(index, n, c);
                 const int oct = octant_of(v, 1u);
                 for (int k = 0; k < 8; ++k) {
                     const int dir = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner i+2j+4k -> octant bits
@@ -117,7 +117,7 @@ template <typename T> struct OctreeCorners {
                 }
                 return;
             }
-            index = n.child_index(c);
+            index = tree.child_index(d, index, n, c);
             ++d;
         }
     }

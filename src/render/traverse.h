@@ -233,8 +233,8 @@ private:
             if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
             else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;
-                hit = cap(w, w.trace, tree_.cap(n, c), co, t_cur, t_next, blocks);
-            } else hit = node(w, d + 1, n.child_index(c), co, t_cur, t_next);
+                hit = cap(w, w.trace, tree_.cap(index, n, c), co, t_cur, t_next, blocks);
+            } else hit = node(w, d + 1, tree_.child_index(d, index, n, c), co, t_cur, t_next);
             return hit;
         });
         return hit;
@@ -442,7 +442,7 @@ private:
                 }
             } else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;   // located once for every lane that crosses this cap
-                const CapRef<T> ci = tree_.cap(n, int(c));
+                const CapRef<T> ci = tree_.cap(index, n, int(c));
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
                     if (cap(p.lane[k], p.trace, ci, co, c0[k], c1[k], blocks)) hit |= 1u << k;
@@ -452,10 +452,10 @@ private:
                     const int k = std::countr_zero(m);
                     Walk& w = p.lane[k];
                     std::copy(p.trace, p.trace + d + 1, w.trace);
-                    if (node(w, d + 1, n.child_index(int(c)), co, c0[k], c1[k])) hit |= 1u << k;
+                    if (node(w, d + 1, tree_.child_index(d, index, n, int(c)), co, c0[k], c1[k])) hit |= 1u << k;
                 }
             } else {
-                hit = entered & ~packet_node(p, d + 1, n.child_index(int(c)), co, entered, flip, c0, c1);
+                hit = entered & ~packet_node(p, d + 1, tree_.child_index(d, index, n, int(c)), co, entered, flip, c0, c1);
             }
             active &= ~hit;
         }

@@ -163,9 +163,7 @@ TEST_F(RenderCli, VerifyTouchedGivesTheSameImageAndRefusesABadNode) {
     EXPECT_NE(json.find("\"open_to_first_frame_seconds\""), std::string::npos) << json;
 
     OctBytes b(big);
-    auto root = b.node<uint8_t>(0, 0, 0);
-    root.child_start = 0xffffffffu;
-    b.set_node(0, 0, 0, root);
+    b.set_group_base(0, 0, 0, 0xffffffffu);   // the root's children far past depth 1
     b.rechecksum();
     const std::string bad = out.file("bad.oct");
     b.save(bad);
@@ -173,7 +171,7 @@ TEST_F(RenderCli, VerifyTouchedGivesTheSameImageAndRefusesABadNode) {
         SCOPED_TRACE(mode);
         std::string err;
         EXPECT_EQ(run("octiso-render", "'" + bad + "'" + common + "--verify " + mode + " -o '" + out.file("x.png") + "'", nullptr, &err), 2);
-        EXPECT_NE(err.find("bad.oct: step 0, depth 0 (interior nodes), node 0: child_start + popcount(child_mask) runs past"),
+        EXPECT_NE(err.find("bad.oct: step 0, depth 0 (interior nodes), node 0: group base + child_offset + popcount(child_mask) runs past"),
                   std::string::npos) << err;
         EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
         EXPECT_FALSE(fs::exists(out.file("x.png")));

@@ -232,10 +232,10 @@ TEST(OctWriter, RefusesAnInconsistentTree) {
     ScratchDir dir;
     const auto v = make_volume<uint8_t>({8, 8, 8}, Pattern::Random, 1);
     const auto b = build_octree(v.view(), {});
-    std::vector<InteriorNode<uint8_t>> root(b.view().arrays().nodes[0], b.view().arrays().nodes[0] + 1);
-    root[0].child_start = 1;   // one past the start of depth 1: the last child runs off the end
+    // The root's group base one past the start of depth 1: the last child runs off the end.
+    const uint64_t base = 1;
     OctreeArrays<uint8_t> a = b.view().arrays();
-    a.nodes[0] = root.data();
+    a.group_base[0] = &base;
     {
         OctWriter w(dir.file("a.oct"), info_for(ScalarType::u8, v.dims));
         EXPECT_THROW(w.add_step(Octree<uint8_t>(a)), Error);
@@ -251,7 +251,8 @@ TEST(DecodeToDense, HandMadeTreeMatchesPointLocationOnEveryVoxel) {
     const Dims dims{3, 4, 2};
     InteriorNode<int16_t> root{};
     root.child_mask = 0b00100001;
-    root.child_start = 0;
+    root.child_offset = 0;
+    const uint64_t base = 0;
     root.cap_bits = 16;   // caps stored whole (octree.h): 8 int16 voxels each, then the read slack
     for (int c = 0; c < 8; ++c) root.scalar[c] = int16_t(-100 * c - 1);
     std::vector<int16_t> caps(2 * 8 + kCapReadSlack / sizeof(int16_t), 0);
@@ -262,6 +263,7 @@ TEST(DecodeToDense, HandMadeTreeMatchesPointLocationOnEveryVoxel) {
     a.dmax = 2;
     a.nodes[0] = &root;
     a.node_count[0] = 1;
+    a.group_base[0] = &base;
     a.caps = reinterpret_cast<const uint8_t*>(caps.data());
     a.cap_bytes = 2 * 16;
     a.cap_count = 2;

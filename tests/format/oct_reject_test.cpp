@@ -161,15 +161,20 @@ TEST(OctReject, ChildIndicesOutOfRangeOrOverlappingAreErrors) {
         fx.expect_rejected([&](OctBytes& b) {
             const uint64_t i = last_parent(b, d);
             auto n = b.node<uint8_t>(0, d, i);
-            n.child_start += 1;   // past the end of the next level
+            n.child_offset += 1;   // past the end of the next level
             b.set_node(0, d, i, n);
-        }, "child_start one too large");
+        }, "child_offset one too large");
         fx.expect_rejected([&](OctBytes& b) {
             const uint64_t i = last_parent(b, d);
-            auto n = b.node<uint8_t>(0, d, i);
-            n.child_start = std::numeric_limits<uint32_t>::max();   // 32-bit wrap if added in 32 bits
-            b.set_node(0, d, i, n);
-        }, "child_start at the 32-bit limit");
+            b.set_group_base(0, d, i >> kNodeGroupShift, std::numeric_limits<uint32_t>::max());   // 32-bit wrap if added in 32 bits
+        }, "group base at the 32-bit limit");
+        fx.expect_rejected([&](OctBytes& b) {
+            const uint64_t i = last_parent(b, d);
+            b.set_group_base(0, d, i >> kNodeGroupShift, std::numeric_limits<uint64_t>::max());   // wraps if added
+        }, "group base at the 64-bit limit");
+        fx.expect_rejected([&](OctBytes& b) {
+            b.set_group_base(0, d, 0, b.group_base(0, d, 0) + 1);   // a gap before the level's first child
+        }, "group base one too large");
         fx.expect_rejected([&](OctBytes& b) {
             const uint64_t i = last_parent(b, d);
             auto n = b.node<uint8_t>(0, d, i);
@@ -189,11 +194,7 @@ TEST(OctReject, ChildIndicesOutOfRangeOrOverlappingAreErrors) {
                 n.cap_bits = 1;
                 b.set_node(0, d, 0, n);
             }, "cap_bits above the cap parents");
-            fx.expect_rejected([&](OctBytes& b) {
-                auto n = b.node<uint8_t>(0, d, 0);
-                n.child_start_hi = 1;
-                b.set_node(0, d, 0, n);
-            }, "48-bit offset above the cap parents");
+
         } else {
             fx.expect_rejected([&](OctBytes& b) {
                 const uint64_t i = last_parent(b, d);
@@ -202,10 +203,9 @@ TEST(OctReject, ChildIndicesOutOfRangeOrOverlappingAreErrors) {
                 b.set_node(0, d, i, n);
             }, "cap_bits one too large");
             fx.expect_rejected([&](OctBytes& b) {
-                auto n = b.node<uint8_t>(0, d, last_parent(b, d));
-                n.child_start_hi = 1;   // 2^32 bytes on
-                b.set_node(0, d, last_parent(b, d), n);
-            }, "cap offset past the level in its high bits");
+                const uint64_t g = last_parent(b, d) >> kNodeGroupShift;
+                b.set_group_base(0, d, g, b.group_base(0, d, g) + (uint64_t(1) << 32));   // 2^32 bytes on
+            }, "cap offset past the level in its group base's high bits");
         }
     }
 }
@@ -256,6 +256,12 @@ TEST(OctReject, CompactNodeFieldsAreValidated) {
         b.bytes[s.offset + s.bytes - 1] = 1;   // the read slack after the last cap
     }, "bytes after the last cap are not zero");
     expect([&](OctBytes& b) {
+        // Format 5: a group's first node starts at its base; the offset moves into the base.
+        auto n = b.node<uint16_t>(0, dmax - 2, 0);
+        n.child_offset = 1;
+        b.set_node(0, dmax - 2, 0, n);
+    }, "the first node of a group must have child_offset 0 (found 1)");
+    expect([&](OctBytes& b) {
         // A cap level shorter than its read slack: the table says 7 bytes.
         const uint64_t i = b.entry_index(0, dmax - 1);
         SectionEntry s = b.entry(i);
@@ -264,13 +270,42 @@ TEST(OctReject, CompactNodeFieldsAreValidated) {
     }, "the cap level must end with 8 zero bytes");
 }
 
+/// Format 5 (issue 19): the zero bytes between an interior level's records and its group bases
+/// (u8 records are 22 bytes, so a level of one node has 2), and the zero tail of a double record.
+TEST(OctReject, GroupPaddingAndRecordTailMustBeZero) {
+    {
+        Fixture fx;
+        fx.expect_rejected([&](OctBytes& b) {
+            const SectionEntry s = b.entry(b.entry_index(0, 0));
+            ASSERT_EQ(s.count, 1u);
+            ASSERT_EQ(format::group_bases_offset(1, 1), 24u);
+            b.bytes[s.offset + 23] = 1;   // the root's record is 22 bytes, its base at 24
+        }, "padding before the group bases");
+    }
+    ScratchDir dir;
+    const std::string good = dir.file("good.oct"), bad = dir.file("bad.oct");
+    const auto v = make_volume<double>({9, 6, 5}, Pattern::Random, 3);
+    write_oct<double>(good, info_for(ScalarType::f64, v.dims), {build_octree(v.view(), {}).view()});
+    OctBytes b(good);
+    auto n = b.node<double>(0, 0, 0);
+    ASSERT_EQ(n.tail.zero, 0u);
+    n.tail.zero = 7;
+    b.set_node(0, 0, 0, n);
+    b.rechecksum();
+    b.save(bad);
+    try {
+        load_everything(bad, Verify::Full);
+        ADD_FAILURE() << "a non-zero record tail was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("the record's last 4 bytes must be zero (found 7)"), std::string::npos) << e.what();
+    }
+}
+
 TEST(OctReject, MessagesNameFileStepDepthNodeAndNumbers) {
     Fixture fx;
     OctBytes b(fx.good);
-    auto root = b.node<uint8_t>(1, 0, 0);
     const uint64_t below = b.entry(b.entry_index(1, 1)).count;
-    root.child_start = uint32_t(below);   // every child past the end of depth 1
-    b.set_node(1, 0, 0, root);
+    b.set_group_base(1, 0, 0, below);   // every child of the root past the end of depth 1
     b.rechecksum();
     b.save(fx.bad);
     const OctFile f = OctFile::open(fx.bad, Verify::IndicesOnly);
@@ -299,7 +334,8 @@ TEST(OctReject, OverlappingChildrenAreErrors) {
             if (b.node<uint8_t>(0, 1, i).child_mask) parents.push_back(i);
         ASSERT_GE(parents.size(), 2u);
         auto n = b.node<uint8_t>(0, 1, parents[1]);
-        n.child_start = b.node<uint8_t>(0, 1, parents[0]).child_start;
+        ASSERT_EQ(parents[1] >> kNodeGroupShift, parents[0] >> kNodeGroupShift);
+        n.child_offset = b.node<uint8_t>(0, 1, parents[0]).child_offset;
         b.set_node(0, 1, parents[1], n);
     }, "overlapping children");
 }
@@ -511,6 +547,12 @@ TEST(OctReject, VersionThreeFilesAskToBeConvertedAgain) {
     // Version 3 has this layout but midpoints where level of detail reads corner voxels: read as
     // format 4 it would render a wrong coarse surface without any error.
     expect_version_refused(3);
+}
+
+TEST(OctReject, VersionFourFilesAskToBeConvertedAgain) {
+    // Version 4 kept a 48-bit first child in every node and exact u8 bounds: its records are not
+    // format 5's (issue 19).
+    expect_version_refused(4);
 }
 
 TEST(OctReject, NonFilesAndEmptyFilesAreErrors) {

@@ -79,6 +79,19 @@ struct OctBytes {
     template <typename T> void set_node(uint32_t step, int depth, uint64_t i, const InteriorNode<T>& n) {
         std::memcpy(bytes.data() + entry(entry_index(step, depth)).offset + i * sizeof n, &n, sizeof n);
     }
+    /// Group base g of the interior section (step, depth): after its records (oct_layout.h).
+    uint64_t group_base(uint32_t step, int depth, uint64_t g) const {
+        uint64_t v;
+        std::memcpy(&v, bytes.data() + group_base_at(step, depth, g), sizeof v);
+        return v;
+    }
+    void set_group_base(uint32_t step, int depth, uint64_t g, uint64_t v) {
+        std::memcpy(bytes.data() + group_base_at(step, depth, g), &v, sizeof v);
+    }
+    uint64_t group_base_at(uint32_t step, int depth, uint64_t g) const {
+        const format::SectionEntry s = entry(entry_index(step, depth));
+        return s.offset + format::group_bases_offset(s.count, header().scalar_bytes) + 8 * g;
+    }
 
     /// Recomputes every section checksum (sections whose bounds are sane), the table checksum and
     /// the header checksum, in that order.

@@ -73,24 +73,28 @@ TEST(TouchValidation, NodeDefectsAreFoundWhenReadWithFullsMessage) {
     struct Edit {
         const char* what;
         int depth;   // -1: the cap parents
-        void (*apply)(InteriorNode<uint8_t>&);
+        void (*apply)(InteriorNode<uint8_t>&);   // or, when null, to its group base
+        uint64_t (*base)(uint64_t);
     };
     const Edit edits[] = {
-        {"child_start at the 32-bit limit", 1, [](InteriorNode<uint8_t>& n) { n.child_start = 0xffffffffu; }},
-        {"child_start past the level", 2, [](InteriorNode<uint8_t>& n) { n.child_start += 1u << 30; }},
-        {"cap offset past the level", -1, [](InteriorNode<uint8_t>& n) { n.child_start_hi = 7; }},
-        {"cap width out of range", -1, [](InteriorNode<uint8_t>& n) { n.cap_bits = 9; }},
-        {"cap width above the cap parents", 1, [](InteriorNode<uint8_t>& n) { n.cap_bits = 3; }},
+        {"group base at the 32-bit limit", 1, nullptr, [](uint64_t) { return uint64_t(0xffffffffu); }},
+        {"group base past the level", 2, nullptr, [](uint64_t v) { return v + (uint64_t(1) << 30); }},
+        {"cap offset past the level", -1, nullptr, [](uint64_t v) { return v + (uint64_t(7) << 32); }},
+        {"cap width out of range", -1, [](InteriorNode<uint8_t>& n) { n.cap_bits = 9; }, nullptr},
+        {"cap width above the cap parents", 1, [](InteriorNode<uint8_t>& n) { n.cap_bits = 3; }, nullptr},
     };
     for (const Edit& e : edits) {
         SCOPED_TRACE(e.what);
         const int d = e.depth < 0 ? dmax - 2 : e.depth;
         OctBytes b = good;
         const uint64_t count = b.entry(b.entry_index(0, d)).count;
-        const uint64_t i = count - 1 - count / 3;   // somewhere past the first block of a big level
+        // Somewhere past the first block of a big level, a group's first node (the first a bad
+        // group base makes bad).
+        const uint64_t i = (count - 1 - count / 3) & ~(kNodeGroup - 1);
         auto n = b.node<uint8_t>(0, d, i);
         ASSERT_NE(n.child_mask, 0) << "random data: every node has children";
-        e.apply(n);
+        if (e.apply) e.apply(n);
+        else b.set_group_base(0, d, i >> kNodeGroupShift, e.base(b.group_base(0, d, i >> kNodeGroupShift)));
         b.set_node(0, d, i, n);
         b.rechecksum();
         b.save(fx.bad);
@@ -116,9 +120,8 @@ TEST(TouchValidation, ADefectInABlockNeverReadIsNotReported) {
     OctBytes b(fx.good);
     const int d = b.header().dmax - 2;
     const uint64_t middle = b.entry(b.entry_index(0, d)).count / 2;
-    auto n = b.node<uint8_t>(0, d, middle);
-    n.child_start_hi = 7;
-    b.set_node(0, d, middle, n);
+    const uint64_t g = middle >> kNodeGroupShift;
+    b.set_group_base(0, d, g, b.group_base(0, d, g) + (uint64_t(7) << 32));   // the caps of the middle group, far past the level
     b.rechecksum();
     b.save(fx.bad);
     const OctFile f = OctFile::open(fx.bad, Verify::Touched);
@@ -135,7 +138,7 @@ TEST(TouchValidation, RulesAcrossNodesAreLeftToFullAndStaySafe) {
     BigFile fx;
     OctBytes b(fx.good);
     auto first = b.node<uint8_t>(0, 1, 0), second = b.node<uint8_t>(0, 1, 1);
-    second.child_start = first.child_start;
+    second.child_offset = first.child_offset;
     second.child_mask = first.child_mask;
     b.set_node(0, 1, 1, second);
     b.rechecksum();

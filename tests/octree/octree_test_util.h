@@ -60,7 +60,7 @@ void for_each_node(const Octree<T>& tree, const std::function<void(int, uint32_t
         const uint32_t half = tree.child_bit(d);
         for (int c = 0; c < 8; ++c)
             if (!n.is_scalar_leaf(c))
-                rec(d + 1, n.child_index(c), Coord{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)});
+                rec(d + 1, tree.child_index(d, i, n, c), Coord{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)});
     };
     rec(0, 0, Coord{});
 }

@@ -65,7 +65,7 @@ template <typename T> void expect_lattice_values(Field field, Dims dims) {
                         const auto& n = tree.node(d, index);
                         const int c = octant_of(start, tree.child_bit(d));
                         if (tree.child_bit(d) <= unit || n.is_scalar_leaf(c) || d + 1 == tree.cap_depth()) break;
-                        index = n.child_index(c);
+                        index = tree.child_index(d, index, n, c);
                         ++d;
                     }
                     ASSERT_EQ(tree.lattice_value(start, Coord{x, y, z}, unit, d, trace), want)
