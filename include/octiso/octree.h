@@ -269,6 +269,19 @@ public:
     OCTISO_ALWAYS_INLINE uint64_t first_child(int d, uint64_t i) const {
         return a_.group_base[size_t(d)][i >> kNodeGroupShift] + a_.nodes[size_t(d)][i].child_offset;
     }
+    /// The same for `n`, node i at depth d, already at hand.
+    OCTISO_ALWAYS_INLINE uint64_t first_child(int d, uint64_t i, const InteriorNode<T>& n) const {
+        return a_.group_base[size_t(d)][i >> kNodeGroupShift] + n.child_offset;
+    }
+    /// Stored child c of `n`, whose first child is `first`: its index (n above dmax-2), or its cap
+    /// (n at dmax-2). The traversal reads `first` once per node, on entry, so that its two
+    /// dependent loads overlap the node's split.
+    OCTISO_ALWAYS_INLINE uint32_t child_index_at(uint64_t first, const InteriorNode<T>& n, int c) const {
+        return uint32_t(first + n.rank(c));
+    }
+    OCTISO_ALWAYS_INLINE CapRef<T> cap_at(uint64_t first, const InteriorNode<T>& parent, int c) const {
+        return {a_.caps + first + uint64_t(parent.rank(c)) * parent.cap_bits, parent.cap_bits, parent.scalar[c]};
+    }
     /// Index at depth d+1 of stored child c of `n`, node i at depth d < dmax-2.
     OCTISO_ALWAYS_INLINE uint32_t child_index(int d, uint64_t i, const InteriorNode<T>& n, int c) const {
         return uint32_t(a_.group_base[size_t(d)][i >> kNodeGroupShift] + n.child_offset + n.rank(c));

@@ -212,6 +212,7 @@ private:
         OCTISO_DCHECK(index < tree_.node_count(d), "node ", index, " of ", tree_.node_count(d), " at depth ", d);
         w.trace[d] = index;
         const InteriorNode<T>& n = tree_.node(d, index);
+        const uint64_t first = tree_.first_child(d, index, n);
         const uint32_t half = tree_.child_bit(d);
         if constexpr (Recorder::kOn) recorder_.enter_node(d, index, o, 2 * half, t0, t1);
         bool hit = false;
@@ -233,8 +234,8 @@ private:
             if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
             else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;
-                hit = cap(w, w.trace, tree_.cap(index, n, c), co, t_cur, t_next, blocks);
-            } else hit = node(w, d + 1, tree_.child_index(d, index, n, c), co, t_cur, t_next);
+                hit = cap(w, w.trace, tree_.cap_at(first, n, c), co, t_cur, t_next, blocks);
+            } else hit = node(w, d + 1, tree_.child_index_at(first, n, c), co, t_cur, t_next);
             return hit;
         });
         return hit;
@@ -408,6 +409,7 @@ private:
         OCTISO_DCHECK(index < tree_.node_count(d), "node ", index, " of ", tree_.node_count(d), " at depth ", d);
         p.trace[d] = index;
         const InteriorNode<T>& n = tree_.node(d, index);
+        const uint64_t first = tree_.first_child(d, index, n);
         const uint32_t half = tree_.child_bit(d);
         PacketSplit split;
         split.split(*this, p, o, half, active, t0, t1);
@@ -442,7 +444,7 @@ private:
                 }
             } else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks;   // located once for every lane that crosses this cap
-                const CapRef<T> ci = tree_.cap(index, n, int(c));
+                const CapRef<T> ci = tree_.cap_at(first, n, int(c));
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
                     if (cap(p.lane[k], p.trace, ci, co, c0[k], c1[k], blocks)) hit |= 1u << k;
@@ -452,10 +454,10 @@ private:
                     const int k = std::countr_zero(m);
                     Walk& w = p.lane[k];
                     std::copy(p.trace, p.trace + d + 1, w.trace);
-                    if (node(w, d + 1, tree_.child_index(d, index, n, int(c)), co, c0[k], c1[k])) hit |= 1u << k;
+                    if (node(w, d + 1, tree_.child_index_at(first, n, int(c)), co, c0[k], c1[k])) hit |= 1u << k;
                 }
             } else {
-                hit = entered & ~packet_node(p, d + 1, tree_.child_index(d, index, n, int(c)), co, entered, flip, c0, c1);
+                hit = entered & ~packet_node(p, d + 1, tree_.child_index_at(first, n, int(c)), co, entered, flip, c0, c1);
             }
             active &= ~hit;
         }
