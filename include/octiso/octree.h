@@ -10,8 +10,9 @@
 // child_bit(d) = 2^(dmax-d-1). Child octant c = x<<2 | y<<1 | z, where x = 1 for the upper half.
 //
 // The compact layout (issue 19; measured by `octiso-bench compression`, BENCHMARKS.md):
-//  - child bounds are quantized conservatively inside the node's own exact range: 8 bits for
-//    wider scalars (Knoll 2006 stored 8-bit min/max too), 4 bits for 1-byte scalars (format 5);
+//  - child bounds are quantized conservatively to 8 bits inside the node's own exact range
+//    (Knoll 2006 stored 8-bit min/max too); 1-byte scalars keep their exact bounds, which are
+//    no larger;
 //  - a node's first child is a 64-bit base per group of 128 nodes plus a 16-bit offset
 //    (format 5), not a 48-bit number per node;
 //  - a cap is stored as 8 deltas of `cap_bits` bits from a base held in its parent's scalar slot
@@ -70,43 +71,47 @@ inline constexpr uint64_t kCapReadSlack = 8;
 /// ChildBounds<T>: [lower(c), upper(c)] contains the trilinear interpolant on every data cell
 /// whose lower corner lies in child c (the one-voxel forward layer +x,+y,+z counts). With no
 /// such cell (pure padding or the last data layer) the bounds are empty and traversal skips the
-/// child. Codes of kCodeBits bits inside [lo, hi], the exact range of the node's children
-/// together, in steps of s = hi/top - lo/top (top = 2^kCodeBits - 1; finite for every double
-/// range): a lower code q stands for lo + q s (0: lo exactly), an upper code q for
-/// hi - (top - q) s (top: hi exactly). Wider scalars take 8-bit codes (Knoll 2006 stored 8-bit
-/// min/max); 1-byte scalars 4-bit codes, both codes of a child in one byte (format 5, issue 19:
-/// their exact 8-bit bounds were half of a u8 node; the cost is 9-10 % more cap children that pass
-/// the cull on plume and mixing, measured in BENCHMARKS.md "The compact octree, format 5"). No
-/// branch and no select in the decode (the first version, 0 and top as special cases, cost
-/// packet_node 19 %, perf on Marschner-Lobb 256^3). The packer picks the largest lower and
-/// smallest upper code that still contain the true range (it runs this same decode), and
-/// qmin > qmax marks an empty child.
-template <typename T> struct ChildBounds {
-    static constexpr bool kNibbles = sizeof(T) == 1;
-    static constexpr int kCodeBits = kNibbles ? 4 : 8;
-    static constexpr int kTop = (1 << kCodeBits) - 1;
-    T lo, hi;
-    /// kNibbles: codes[c] = qmin | qmax << 4; else qmin at codes[c], qmax at codes[8 + c].
-    uint8_t codes[kNibbles ? 8 : 16];
+/// child. 1-byte scalars: the exact min/max (4-bit codes, tried for format 5, made u8 frames
+/// 0.84-0.99 x as fast for 6 % of raw less on plume: BENCHMARKS.md "The compact octree, format
+/// 5"). Wider ones: 8-bit codes inside [lo, hi], the exact
+/// range of the node's children together, in steps of s = hi/255 - lo/255 (finite for every
+/// double range): a lower code q stands for lo + q s (0: lo exactly), an upper code q for
+/// hi - (255 - q) s (255: hi exactly). No branch and no select in the decode (the first version,
+/// 0 and 255 as special cases, cost packet_node 19 %, perf on Marschner-Lobb 256^3). The packer
+/// picks the largest lower and smallest upper code that still contain the true range (it runs
+/// this same decode), and qmin > qmax marks an empty child.
+template <typename T, bool kExact = (sizeof(T) == 1)> struct ChildBounds;
 
-    OCTISO_ALWAYS_INLINE int qmin(int c) const {
-        if constexpr (kNibbles) return codes[c] & 15;
-        else return codes[c];
+template <typename T> struct ChildBounds<T, true> {
+    T min[8];
+    T max[8];
+    OCTISO_ALWAYS_INLINE bool empty(int c) const { return min[c] > max[c]; }
+    OCTISO_ALWAYS_INLINE double lower(int c) const { return double(min[c]); }
+    OCTISO_ALWAYS_INLINE double upper(int c) const { return double(max[c]); }
+    /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
+    double range_lo() const {
+        double v = std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 8; ++c) if (!empty(c) && double(min[c]) < v) v = double(min[c]);
+        return v;
     }
-    OCTISO_ALWAYS_INLINE int qmax(int c) const {
-        if constexpr (kNibbles) return codes[c] >> 4;
-        else return codes[8 + c];
+    double range_hi() const {
+        double v = -std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 8; ++c) if (!empty(c) && double(max[c]) > v) v = double(max[c]);
+        return v;
     }
-    void set_codes(int c, int ql, int qh) {
-        if constexpr (kNibbles) codes[c] = uint8_t(ql | qh << 4);
-        else codes[c] = uint8_t(ql), codes[8 + c] = uint8_t(qh);
-    }
+};
+
+template <typename T> struct ChildBounds<T, false> {
+    T lo, hi;
+    uint8_t qmin[8];
+    uint8_t qmax[8];
+    static constexpr int kTop = 255;
     OCTISO_ALWAYS_INLINE double step() const { return double(hi) * (1.0 / kTop) - double(lo) * (1.0 / kTop); }
     OCTISO_ALWAYS_INLINE double decode_lower(int q, double step) const { return double(lo) + double(q) * step; }
     OCTISO_ALWAYS_INLINE double decode_upper(int q, double step) const { return double(hi) - double(kTop - q) * step; }
-    OCTISO_ALWAYS_INLINE bool empty(int c) const { return qmin(c) > qmax(c); }
-    OCTISO_ALWAYS_INLINE double lower(int c) const { return decode_lower(qmin(c), step()); }
-    OCTISO_ALWAYS_INLINE double upper(int c) const { return decode_upper(qmax(c), step()); }
+    OCTISO_ALWAYS_INLINE bool empty(int c) const { return qmin[c] > qmax[c]; }
+    OCTISO_ALWAYS_INLINE double lower(int c) const { return decode_lower(qmin[c], step()); }
+    OCTISO_ALWAYS_INLINE double upper(int c) const { return decode_upper(qmax[c], step()); }
     /// The exact range of all children together: [lo, hi], or lo > hi when every child is empty.
     double range_lo() const {
         for (int c = 0; c < 8; ++c) if (!empty(c)) return double(lo);

@@ -188,7 +188,7 @@ void OctFile::Impl::check_header() {
         fail("is .oct format version 3, whose stored children hold the midpoint of their range, not the corner "
              "voxel level of detail samples (format 4): convert the source again with octiso-convert");
     if (h.version == 4)
-        fail("is .oct format version 4, the node layout before child groups and 4-bit bounds (format 5): convert "
+        fail("is .oct format version 4, the node layout before child groups (format 5): convert "
              "the source again with octiso-convert");
     if (h.version != format::kFormatVersion)
         fail("unsupported format version (expected " + num(format::kFormatVersion) + ", found " + num(h.version) + ")");

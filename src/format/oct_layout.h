@@ -52,12 +52,12 @@
 //
 //  InteriorNode<T> record (s = sizeof(T)), no padding:
 //    +-----------+---------------------------------------+--------------+------------+----------+------+
-//    | scalar[8] | bounds: lo, hi (T), codes              | child_offset | child_mask | cap_bits | tail |
-//    | 8 T       | s == 1: codes[8]  (qmin | qmax << 4)   | u16          | u8         | u8       | s==8:|
-//    |           | s > 1:  qmin[8], qmax[8] (u8)          |              |            | (dmax-2  | u32  |
-//    |           |                                        |              |            |  only)   | zero |
+//    | scalar[8] | bounds                                 | child_offset | child_mask | cap_bits | tail |
+//    | 8 T       | s == 1: min[8], max[8] (T, exact)      | u16          | u8         | u8       | s==8:|
+//    |           | s > 1:  lo, hi (T), qmin[8], qmax[8]   |              |            | (dmax-2  | u32  |
+//    |           |         (u8)                           |              |            |  only)   | zero |
 //    +-----------+---------------------------------------+--------------+------------+----------+------+
-//    22 bytes for 1-byte scalars, 40 for 2, 60 for 4, 104 for 8 (format 4: 32, 44, 64, 104; format 2:
+//    28 bytes for 1-byte scalars, 40 for 2, 60 for 4, 104 for 8 (format 4: 32, 44, 64, 104; format 2:
 //    24 s + 8).
 //  Caps section: a byte array (record_bytes 1, count = its bytes). The caps of one depth dmax-2
 //  parent follow each other from its first_child() byte, each cap_bits bytes: 8 deltas of
@@ -80,9 +80,8 @@ inline constexpr char kMagic[8] = {'O', 'C', 'T', 'I', 'S', 'O', '\0', '\x1a'};
 /// 4: a stored interior child's scalar is the voxel at its lower corner, the level-of-detail
 /// lattice sample (issue 14), where format 3 kept the midpoint of its range; same layout, and
 /// version 3 files are refused with a message to convert again (`--lod` would misread them).
-/// 5: first children as group bases plus 16-bit offsets, 4-bit bounds codes for 1-byte scalars,
-/// the scalars first in the record (issue 19); version 4 files are refused with a message to
-/// convert again.
+/// 5: first children as group bases plus 16-bit offsets, the scalars first in the record (issue
+/// 19); version 4 files are refused with a message to convert again.
 inline constexpr uint32_t kFormatVersion = 5;
 inline constexpr uint32_t kEndianTag = 0x01020304u;   ///< reads back as 0x04030201 if swapped
 inline constexpr uint64_t kSectionAlign = 64;
@@ -151,7 +150,7 @@ static_assert(offsetof(SectionEntry, offset) == 16 && offsetof(SectionEntry, che
 template <typename T> constexpr bool record_layout_ok() {
     using N = InteriorNode<T>;
     constexpr size_t s = sizeof(T);
-    constexpr size_t bounds = 2 * s + (s == 1 ? 8 : 16);
+    constexpr size_t bounds = s == 1 ? 16 : 2 * s + 16;
     return std::is_trivially_copyable_v<N> && std::is_standard_layout_v<N> &&
            sizeof(N) == 8 * s + bounds + 4 + (s == 8 ? 4 : 0) && offsetof(N, scalar) == 0 &&
            offsetof(N, bounds) == 8 * s && offsetof(N, child_offset) == 8 * s + bounds &&
@@ -165,7 +164,7 @@ static_assert(record_layout_ok<uint8_t>() && record_layout_ok<int8_t>() && recor
 /// Size of one record of each kind for a scalar of `scalar_bytes` bytes (1, 2, 4 or 8); the cap
 /// level is a byte array.
 inline constexpr uint64_t interior_record_bytes(uint64_t scalar_bytes) {
-    return 10 * scalar_bytes + (scalar_bytes == 1 ? 12 : scalar_bytes == 8 ? 24 : 20);
+    return scalar_bytes == 1 ? 28 : 10 * scalar_bytes + (scalar_bytes == 8 ? 24 : 20);
 }
 inline constexpr uint64_t cap_record_bytes(uint64_t) { return 1; }
 static_assert(interior_record_bytes(1) == sizeof(InteriorNode<uint8_t>) &&

@@ -65,7 +65,7 @@ std::string where(uint32_t step, int depth, int dmax) {
 }
 
 // The node's own fields (format 5, octree.h): the cap width where caps lie below and zero width
-// elsewhere, a zero tail, ordered finite bounds, lattice samples inside their ranges; then its
+// elsewhere, a zero tail, ordered finite bounds (wider scalars), lattice samples inside their ranges; then its
 // children inside the level below. Allocation-free: the touch validator runs it in a fault
 // handler (touch_validation.h); node_problem() words the same checks for a message.
 template <typename T>
@@ -77,7 +77,7 @@ NodeDefect node_defect(const InteriorNode<T>& n, uint64_t group_base, bool caps_
     }
     if constexpr (sizeof(T) == 8)
         if (n.tail.zero != 0) return NodeDefect::tail;
-    {
+    if constexpr (sizeof(T) > 1) {
         const double lo = double(n.bounds.lo), hi = double(n.bounds.hi);
         if (!(std::isfinite(lo) && std::isfinite(hi) && lo <= hi)) return NodeDefect::bounds;
     }
@@ -112,8 +112,10 @@ std::string node_problem(const InteriorNode<T>& n, uint64_t group_base, bool cap
         if constexpr (sizeof(T) == 8) return "the record's last 4 bytes must be zero (found " + std::to_string(n.tail.zero) + ")";
         return "the record's tail must be zero";
     case NodeDefect::bounds:
-        return "bounds range is not finite and ordered (found lo " + std::to_string(double(n.bounds.lo)) + ", hi " +
-               std::to_string(double(n.bounds.hi)) + ")";
+        if constexpr (sizeof(T) > 1)
+            return "bounds range is not finite and ordered (found lo " + std::to_string(double(n.bounds.lo)) + ", hi " +
+                   std::to_string(double(n.bounds.hi)) + ")";
+        return "bounds range is not finite and ordered";
     case NodeDefect::lattice_sample:
         for (int c = 0; c < 8; ++c) {
             if (!((n.child_mask >> c) & 1u) || n.bounds.empty(c)) continue;

@@ -1,5 +1,5 @@
-// Packing into the compact node layout (octree.h, issue 19): conservative 8-bit (4-bit for 1-byte
-// scalars) child bounds and caps as deltas from a base. The builders (summary.h) call these as each node is finished, so no
+// Packing into the compact node layout (octree.h, issue 19): conservative 8-bit child bounds and
+// caps as deltas from a base. The builders (summary.h) call these as each node is finished, so no
 // wide copy of the tree is ever held. Each code is chosen by running the reader's own decode
 // (ChildBounds::decode), so the bounds contain the true range bit for bit on every ISA.
 #pragma once
@@ -17,36 +17,41 @@ namespace octiso::detail {
 
 /// Bounds of 8 children whose exact cell ranges are [mn[c], mx[c]] (mn > mx: empty).
 template <typename T> ChildBounds<T> pack_bounds(const T (&mn)[8], const T (&mx)[8]) {
-    ChildBounds<T> b{};
-    constexpr int top = ChildBounds<T>::kTop;
-    bool any = false;
-    T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
-    for (int c = 0; c < 8; ++c)
-        if (mn[c] <= mx[c]) any = true, lo = std::min(lo, mn[c]), hi = std::max(hi, mx[c]);
-    b.lo = any ? lo : T{};
-    b.hi = any ? hi : T{};
-    const double s = b.step(), width = double(b.hi) - double(b.lo);
-    for (int c = 0; c < 8; ++c) {
-        if (!(mn[c] <= mx[c])) {
-            b.set_codes(c, top, 0);
-            continue;
+    ChildBounds<T> b;
+    if constexpr (sizeof(T) == 1) {
+        std::copy(mn, mn + 8, b.min);
+        std::copy(mx, mx + 8, b.max);
+    } else {
+        constexpr int top = ChildBounds<T>::kTop;
+        bool any = false;
+        T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
+        for (int c = 0; c < 8; ++c)
+            if (mn[c] <= mx[c]) any = true, lo = std::min(lo, mn[c]), hi = std::max(hi, mx[c]);
+        b.lo = any ? lo : T{};
+        b.hi = any ? hi : T{};
+        const double s = b.step(), width = double(b.hi) - double(b.lo);
+        for (int c = 0; c < 8; ++c) {
+            if (!(mn[c] <= mx[c])) {
+                b.qmin[c] = uint8_t(top), b.qmax[c] = 0;
+                continue;
+            }
+            const double a = double(mn[c]), z = double(mx[c]);
+            // A first guess from the real quotient, then the decode itself decides.
+            auto guess = [&](double v, bool up) {
+                if (!(width > 0) || !std::isfinite(width)) return up ? top : 0;
+                const double g = (v - double(b.lo)) / width * top;
+                const double r = up ? std::ceil(g) : std::floor(g);
+                return int(std::clamp(r, 0.0, double(top)));
+            };
+            int ql = guess(a, false), qh = guess(z, true);
+            while (ql > 0 && b.decode_lower(ql, s) > a) --ql;
+            while (ql < top && b.decode_lower(ql + 1, s) <= a) ++ql;
+            while (qh < top && b.decode_upper(qh, s) < z) ++qh;
+            while (qh > 0 && b.decode_upper(qh - 1, s) >= z) --qh;
+            if (ql > qh) ql = 0, qh = top;   // a plateau of the decode (lo == hi): the node's own range
+            OCTISO_DCHECK(b.decode_lower(ql, s) <= a && z <= b.decode_upper(qh, s) && ql <= qh, "bounds code of child ", c);
+            b.qmin[c] = uint8_t(ql), b.qmax[c] = uint8_t(qh);
         }
-        const double a = double(mn[c]), z = double(mx[c]);
-        // A first guess from the real quotient, then the decode itself decides.
-        auto guess = [&](double v, bool up) {
-            if (!(width > 0) || !std::isfinite(width)) return up ? top : 0;
-            const double g = (v - double(b.lo)) / width * top;
-            const double r = up ? std::ceil(g) : std::floor(g);
-            return int(std::clamp(r, 0.0, double(top)));
-        };
-        int ql = guess(a, false), qh = guess(z, true);
-        while (ql > 0 && b.decode_lower(ql, s) > a) --ql;
-        while (ql < top && b.decode_lower(ql + 1, s) <= a) ++ql;
-        while (qh < top && b.decode_upper(qh, s) < z) ++qh;
-        while (qh > 0 && b.decode_upper(qh - 1, s) >= z) --qh;
-        if (ql > qh) ql = 0, qh = top;   // a plateau of the decode (lo == hi): the node's own range
-        OCTISO_DCHECK(b.decode_lower(ql, s) <= a && z <= b.decode_upper(qh, s) && ql <= qh, "bounds code of child ", c);
-        b.set_codes(c, ql, qh);
     }
     return b;
 }

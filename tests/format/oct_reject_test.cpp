@@ -271,15 +271,15 @@ TEST(OctReject, CompactNodeFieldsAreValidated) {
 }
 
 /// Format 5 (issue 19): the zero bytes between an interior level's records and its group bases
-/// (u8 records are 22 bytes, so a level of one node has 2), and the zero tail of a double record.
+/// (u8 records are 28 bytes, so a level of one node has 4), and the zero tail of a double record.
 TEST(OctReject, GroupPaddingAndRecordTailMustBeZero) {
     {
         Fixture fx;
         fx.expect_rejected([&](OctBytes& b) {
             const SectionEntry s = b.entry(b.entry_index(0, 0));
             ASSERT_EQ(s.count, 1u);
-            ASSERT_EQ(format::group_bases_offset(1, 1), 24u);
-            b.bytes[s.offset + 23] = 1;   // the root's record is 22 bytes, its base at 24
+            ASSERT_EQ(format::group_bases_offset(1, 1), 32u);
+            b.bytes[s.offset + 31] = 1;   // the root's record is 28 bytes, its base at 32
         }, "padding before the group bases");
     }
     ScratchDir dir;
@@ -550,8 +550,7 @@ TEST(OctReject, VersionThreeFilesAskToBeConvertedAgain) {
 }
 
 TEST(OctReject, VersionFourFilesAskToBeConvertedAgain) {
-    // Version 4 kept a 48-bit first child in every node and exact u8 bounds: its records are not
-    // format 5's (issue 19).
+    // Version 4 kept a 48-bit first child in every node: its records are not format 5's (issue 19).
     expect_version_refused(4);
 }
 

@@ -95,12 +95,14 @@ TYPED_TEST(OctreeBuild, MinMaxEqualsExactCellRangeOfEveryChild) {
                     const bool has_cells = exact_cell_range<T>(dims, co, half, [&](uint32_t x, uint32_t y, uint32_t z) { return v.at(x, y, z); }, lo, hi);
                     if (!has_cells) {
                         EXPECT_TRUE(n.bounds.empty(c)) << "child without data cells must have an empty range";
+                    } else if constexpr (sizeof(T) == 1) {   // exact bounds (octree.h)
+                        EXPECT_EQ(n.bounds.lower(c), lo) << "depth " << d << " child " << c;
+                        EXPECT_EQ(n.bounds.upper(c), hi) << "depth " << d << " child " << c;
                     } else {
-                        // Codes (8-bit, 4-bit for 1-byte scalars) in the node's exact range: they
-                        // contain the cell range and are the tightest codes that do (within one
-                        // code step of it).
+                        // 8-bit codes in the node's exact range: they contain the cell range and
+                        // are the tightest codes that do (within one code step of it).
                         ASSERT_FALSE(n.bounds.empty(c));
-                        const double step = (double(n.bounds.hi) - double(n.bounds.lo)) / ChildBounds<T>::kTop;
+                        const double step = (double(n.bounds.hi) - double(n.bounds.lo)) / 255;
                         EXPECT_LE(n.bounds.lower(c), lo) << "depth " << d << " child " << c;
                         EXPECT_GE(n.bounds.upper(c), hi) << "depth " << d << " child " << c;
                         EXPECT_LE(lo - n.bounds.lower(c), step * 1.001) << "depth " << d << " child " << c;
