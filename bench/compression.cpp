@@ -69,6 +69,10 @@ struct Result {
     std::optional<double> frame, baseline_frame;
     uint64_t baseline_file_bytes = 0;
     bool baseline_images_equal = false;
+    uint64_t scalars() const { return interior_nodes * 8 * scalar_bytes_size; }
+    /// What the interior levels hold beside scalars and bounds (format 5: child offsets, masks,
+    /// cap widths, group bases and their padding).
+    uint64_t indices() const { return interior_bytes - scalars() - minmax_bytes; }
     /// Format 2 (before issue 19): InteriorNode 24 s + 8 bytes, Cap 8 s bytes, same counts.
     uint64_t format2_interior() const { return interior_nodes * (24 * scalar_bytes_size + 8); }
     uint64_t format2_caps() const { return caps * 8 * scalar_bytes_size; }
@@ -274,7 +278,7 @@ void write_results(cli::JsonWriter& j, const std::vector<Result>& results, int s
         j.field("raw_bytes", r.raw_bytes).field("file_bytes", r.file_bytes).field("percent_of_raw", r.percent());
         j.field("interior_bytes", r.interior_bytes).field("minmax_bytes", r.minmax_bytes).field("cap_bytes", r.cap_bytes);
         j.field("interior_nodes", r.interior_nodes).field("caps", r.caps);
-        j.field("scalar_bytes", r.interior_nodes * 8 * r.scalar_bytes_size).field("index_bytes", r.interior_nodes * 8);
+        j.field("scalar_bytes", r.scalars()).field("index_bytes", r.indices());
         j.field("format2_interior_bytes", r.format2_interior()).field("format2_minmax_bytes", r.format2_minmax());
         j.field("format2_cap_bytes", r.format2_caps()).field("format2_percent_of_raw", r.format2_percent());
         j.field("iso", r.iso);
@@ -397,11 +401,8 @@ int run_compression(cli::Args& args) {
                  "baseline ms", "speed-up", "same image"});
     for (const Result& r : rows) {
         const bool b = r.baseline_frame.has_value();
-        // Indices: what the interior levels hold beside scalars and bounds (child offsets, masks,
-        // cap widths, group bases and their padding).
-        const uint64_t scalars = r.interior_nodes * 8 * r.scalar_bytes_size;
-        parts.add({r.set.name, r.type, std::to_string(r.interior_nodes), std::to_string(r.caps), mib(scalars),
-                   mib(r.minmax_bytes), mib(r.interior_bytes - scalars - r.minmax_bytes), mib(r.cap_bytes),
+        parts.add({r.set.name, r.type, std::to_string(r.interior_nodes), std::to_string(r.caps), mib(r.scalars()),
+                   mib(r.minmax_bytes), mib(r.indices()), mib(r.cap_bytes),
                    fmt(r.percent(), 1), b ? fmt(100.0 * double(r.baseline_file_bytes) / double(r.raw_bytes), 1) : "-",
                    mib(r.format2_minmax()), mib(r.format2_caps()),
                    fmt(r.format2_percent(), 1), fmt(r.zstd_percent(), 1), fmt(r.iso, 6),
