@@ -72,10 +72,9 @@ inline constexpr uint64_t kCapReadSlack = 8;
 /// whose lower corner lies in child c (the one-voxel forward layer +x,+y,+z counts). With no
 /// such cell (pure padding or the last data layer) the bounds are empty and traversal skips the
 /// child. 1-byte scalars: the exact min/max (4-bit codes, tried for format 5, made u8 frames
-/// 0.84-0.99 x as fast for 6 % of raw less on plume: BENCHMARKS.md "The compact octree, format
-/// 5"). Wider ones: 8-bit codes inside [lo, hi], the exact
-/// range of the node's children together, in steps of s = hi/255 - lo/255 (finite for every
-/// double range): a lower code q stands for lo + q s (0: lo exactly), an upper code q for
+/// 0.84-0.99 x as fast for 6 % of raw less on plume; BENCHMARKS.md "The compact octree, format
+/// 5"). Wider ones: 8-bit codes inside [lo, hi], the exact range of the node's children
+/// together, in steps of s = hi/255 - lo/255 (finite for every double range): a lower code q stands for lo + q s (0: lo exactly), an upper code q for
 /// hi - (255 - q) s (255: hi exactly). No branch and no select in the decode (the first version,
 /// 0 and 255 as special cases, cost packet_node 19 %, perf on Marschner-Lobb 256^3). The packer
 /// picks the largest lower and smallest upper code that still contain the true range (it runs
@@ -269,12 +268,8 @@ public:
     uint64_t cap_count() const { return a_.cap_count; }
     uint64_t cap_bytes() const { return a_.cap_bytes; }
     const InteriorNode<T>& node(int d, uint64_t i) const { return a_.nodes[size_t(d)][i]; }
-    /// Where the children of node i at depth d start in the level below: a node index, or (d =
-    /// dmax-2) a byte offset into the caps.
-    OCTISO_ALWAYS_INLINE uint64_t first_child(int d, uint64_t i) const {
-        return a_.group_base[size_t(d)][i >> kNodeGroupShift] + a_.nodes[size_t(d)][i].child_offset;
-    }
-    /// The same for `n`, node i at depth d, already at hand.
+    /// Where the children of `n`, node i at depth d, start in the level below: a node index, or
+    /// (d = dmax-2) a byte offset into the caps.
     OCTISO_ALWAYS_INLINE uint64_t first_child(int d, uint64_t i, const InteriorNode<T>& n) const {
         return a_.group_base[size_t(d)][i >> kNodeGroupShift] + n.child_offset;
     }
@@ -289,12 +284,11 @@ public:
     }
     /// Index at depth d+1 of stored child c of `n`, node i at depth d < dmax-2.
     OCTISO_ALWAYS_INLINE uint32_t child_index(int d, uint64_t i, const InteriorNode<T>& n, int c) const {
-        return uint32_t(a_.group_base[size_t(d)][i >> kNodeGroupShift] + n.child_offset + n.rank(c));
+        return child_index_at(first_child(d, i, n), n, c);
     }
     /// Cap child c of `parent`, node i at depth dmax-2.
     OCTISO_ALWAYS_INLINE CapRef<T> cap(uint64_t i, const InteriorNode<T>& parent, int c) const {
-        const uint64_t first = a_.group_base[size_t(a_.dmax - 2)][i >> kNodeGroupShift] + parent.child_offset;
-        return {a_.caps + first + uint64_t(parent.rank(c)) * parent.cap_bits, parent.cap_bits, parent.scalar[c]};
+        return cap_at(first_child(a_.dmax - 2, i, parent), parent, c);
     }
     const OctreeArrays<T>& arrays() const { return a_; }
 

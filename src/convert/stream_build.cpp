@@ -57,6 +57,7 @@ double slab_need(Dims dims, double b, const BuildOptions& options, uint32_t s, b
     if (options.iso_range) need += region * b + region;              // clamped copy + flags
     const uint64_t s_data = std::min<uint64_t>(s, dims.z);
     const double caps = double(ceil_div(dims.x, 2)) * double(ceil_div(dims.y, 2)) * double(ceil_div(s_data, 2)) * 8 * b;
+    // Nodes at format 2's record size, 24 b + 8 bytes: an upper bound of the record sizes of formats 3-5 (octree.h).
     const double nodes =
         double(ceil_div(dims.x, 4)) * double(ceil_div(dims.y, 4)) * double(ceil_div(s_data, 4)) * (24 * b + 8) * 8 / 7;
     need += 2 * (caps + nodes);                                      // the pieces' vectors, growth slack

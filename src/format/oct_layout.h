@@ -60,7 +60,7 @@
 //    28 bytes for 1-byte scalars, 40 for 2, 60 for 4, 104 for 8 (format 4: 32, 44, 64, 104; format 2:
 //    24 s + 8).
 //  Caps section: a byte array (record_bytes 1, count = its bytes). The caps of one depth dmax-2
-//  parent follow each other from its first_child() byte, each cap_bits bytes: 8 deltas of
+//  parent follow each other from its first child (a byte offset), each cap_bits bytes: 8 deltas of
 //  cap_bits bits, little-endian bit order, voxel k at bits [k b, (k+1) b) of the record, added to
 //  the key (ScalarKey) of the parent's scalar[c]; cap_bits == 8 s: the 8 voxels stored whole.
 //  The section ends with kCapReadSlack zero bytes (every delta is one 8-byte load). Octant
