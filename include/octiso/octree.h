@@ -175,10 +175,16 @@ template <typename T> struct InteriorNode {
     }
 };
 
-/// Bytes of one level of `count` nodes as a .oct section holds it (src/format/oct_layout.h): the
-/// records, zero bytes up to a multiple of 8, then the node_groups(count) 64-bit group bases.
+/// A level of nodes as a .oct section holds it (src/format/oct_layout.h): the records, zero bytes
+/// up to a multiple of 8, then the node_groups(count) 64-bit group bases. group_bases_at: where
+/// the bases start after `records` bytes of records; level_bytes: the whole level, `count`
+/// records of `record` bytes (callers keep count * record far below 2^64).
+inline constexpr uint64_t group_bases_at(uint64_t records) { return (records + 7) & ~uint64_t(7); }
+inline constexpr uint64_t level_bytes(uint64_t count, uint64_t record) {
+    return group_bases_at(count * record) + 8 * node_groups(count);
+}
 template <typename T> constexpr uint64_t interior_level_bytes(uint64_t count) {
-    return ((count * sizeof(InteriorNode<T>) + 7) & ~uint64_t(7)) + 8 * node_groups(count);
+    return level_bytes(count, sizeof(InteriorNode<T>));
 }
 
 /// Cap<T>: the 2x2x2 voxels of a node at depth dmax-1, octant order as above; the builders' form

@@ -221,7 +221,7 @@ private:
     void append_group_bases(uint64_t count, const detail::GroupPlacer& placer) {
         static constexpr uint8_t kZero[8] = {};
         const uint64_t records = count * sizeof(InteriorNode<T>);
-        writer_.append_records(kZero, (8 - records % 8) % 8);
+        writer_.append_records(kZero, group_bases_at(records) - records);
         OCTISO_CHECK(placer.bases().size() == node_groups(count), placer.bases().size(), " group bases for ", count, " nodes");
         writer_.append_records(placer.bases().data(), placer.bases().size() * sizeof(uint64_t));
     }

@@ -326,8 +326,9 @@ void OctFile::Impl::check_step_padding(uint32_t k) const {
         if (!all_zero(base + end, s.offset - end))
             fail("section " + num(i) + " (step " + num(k) + ", depth " + num(d) + "): padding before the section is not zero");
         if (d + 1 == info.dmax) continue;
-        const uint64_t records = s.count * format::interior_record_bytes(scalar_type_bytes(info.type)), bases = format::group_bases_offset(s.count, scalar_type_bytes(info.type));
-        if (!all_zero(base + s.offset + records, bases - records))
+        const uint64_t scalar = scalar_type_bytes(info.type);
+        const uint64_t records = s.count * format::interior_record_bytes(scalar);
+        if (!all_zero(base + s.offset + records, format::group_bases_offset(s.count, scalar) - records))
             fail("section " + num(i) + " (step " + num(k) + ", depth " + num(d) +
                  "): padding before the group bases is not zero");
     }

@@ -174,10 +174,10 @@ static_assert(interior_record_bytes(1) == sizeof(InteriorNode<uint8_t>) &&
 /// Where an interior section's group bases start, and its whole size, for `count` records
 /// (callers keep count * record far below 2^64, checked before use).
 inline constexpr uint64_t group_bases_offset(uint64_t count, uint64_t scalar_bytes) {
-    return (count * interior_record_bytes(scalar_bytes) + 7) & ~uint64_t(7);
+    return group_bases_at(count * interior_record_bytes(scalar_bytes));
 }
 inline constexpr uint64_t interior_section_bytes(uint64_t count, uint64_t scalar_bytes) {
-    return group_bases_offset(count, scalar_bytes) + 8 * node_groups(count);
+    return level_bytes(count, interior_record_bytes(scalar_bytes));
 }
 
 /// Next multiple of 64 at or above `x`; callers keep x far below 2^64 (checked before use).

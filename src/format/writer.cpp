@@ -70,7 +70,7 @@ struct OctWriter::Impl {
         write(data, records);
         if (kind == format::SectionKind::Interior) {
             static constexpr uint8_t kZero[8] = {};
-            const uint64_t pad = (8 - records % 8) % 8, bases = 8 * node_groups(count);
+            const uint64_t pad = group_bases_at(records) - records, bases = 8 * node_groups(count);
             sum.update(kZero, size_t(pad));
             write(kZero, pad);
             sum.update(group_bases, size_t(bases));

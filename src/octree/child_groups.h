@@ -17,10 +17,14 @@
 
 namespace octiso::detail {
 
-/// Places the children of a level's nodes one node at a time, in level order.
+/// Places the children of a level's nodes one node at a time, in level order, from node
+/// `first_node` (a group's first) whose first child is `first_child`.
 class GroupPlacer {
 public:
-    explicit GroupPlacer(bool caps_below) : caps_below_(caps_below) {}
+    explicit GroupPlacer(bool caps_below, uint64_t first_node = 0, uint64_t first_child = 0)
+        : caps_below_(caps_below), placed_(first_node), next_(first_child) {
+        OCTISO_DCHECK((first_node & (kNodeGroup - 1)) == 0, "placing from node ", first_node, ", inside a group");
+    }
 
     template <typename T> void place(InteriorNode<T>& n) {
         if ((placed_ & (kNodeGroup - 1)) == 0) bases_.push_back(next_);
@@ -30,19 +34,21 @@ public:
         next_ += n.children_span(caps_below_);
         ++placed_;
     }
-    /// What the nodes placed so far take in the level below: nodes, or bytes of caps.
+    /// Where the next node's children start: what the nodes placed so far take in the level
+    /// below (nodes, or bytes of caps), from first_child on.
     uint64_t children() const { return next_; }
+    /// The bases of the groups begun so far.
     const std::vector<uint64_t>& bases() const { return bases_; }
 
 private:
     bool caps_below_;
-    uint64_t placed_ = 0, next_ = 0;
+    uint64_t placed_, next_;
     std::vector<uint64_t> bases_;
 };
 
 /// Places the children of all `count` nodes of a level (node_groups(count) bases into `bases`),
 /// in parallel over runs of groups: the spans of each run, a prefix sum over the runs, then each
-/// run's offsets. Returns what the level's nodes take below (nodes, or bytes of caps).
+/// run by its own GroupPlacer. Returns what the level's nodes take below (nodes, or bytes of caps).
 template <typename T> uint64_t place_children(InteriorNode<T>* nodes, uint64_t count, bool caps_below, uint64_t* bases) {
     constexpr uint64_t kRun = kNodeGroup * 256;
     const uint64_t runs = (count + kRun - 1) / kRun;
@@ -54,13 +60,9 @@ template <typename T> uint64_t place_children(InteriorNode<T>* nodes, uint64_t c
     });
     for (uint64_t r = 0; r < runs; ++r) run_start[r + 1] += run_start[r];
     tbb::parallel_for(uint64_t(0), runs, [&](uint64_t r) {
-        uint64_t next = run_start[r], base = next;
-        for (uint64_t i = r * kRun, e = std::min(count, i + kRun); i < e; ++i) {
-            if ((i & (kNodeGroup - 1)) == 0) bases[i >> kNodeGroupShift] = base = next;
-            OCTISO_DCHECK(next - base <= UINT16_MAX, "child offset ", next - base, " past 16 bits");
-            nodes[i].child_offset = uint16_t(next - base);
-            next += nodes[i].children_span(caps_below);
-        }
+        GroupPlacer placer(caps_below, r * kRun, run_start[r]);
+        for (uint64_t i = r * kRun, e = std::min(count, i + kRun); i < e; ++i) placer.place(nodes[i]);
+        std::copy(placer.bases().begin(), placer.bases().end(), bases + (r * kRun >> kNodeGroupShift));
     });
     return run_start[runs];
 }
