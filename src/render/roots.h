@@ -54,6 +54,26 @@ template <typename R> inline int extrema_stable(const CellCubic<R>& f, R out[2])
     return quadratic_roots_in_unit(R(3) * f.c[3], R(2) * f.c[2], f.c[1], out);
 }
 
+/// Whether the walk below would find no root on [0, 1] whatever the finder: true only where the
+/// cubic's Bernstein coefficients on [0, 1] (whose hull bounds it there) all exceed, with one
+/// sign, a margin far above the rounding of any evaluation the walk makes, and f_out (evaluated
+/// apart, from the corners) is non-zero with that sign. Then f(e) at every stationary point a
+/// finder returns keeps the sign of f_in, so the walk would end in kNoHit: the same result
+/// without the stationary points (a square root, divisions) and their evaluations.
+/// Margin: the hull and Horner's f(e) on [0, 1] each round by under 8u (|c0| + .. + |c3|),
+/// u = 2^-53 for double (less for long double); 2^-40 of that sum is over 100 times more.
+/// Most cells whose corner range holds the isovalue are not hit (ch2better 100.5: 118 k of 166 k
+/// per 512^2 frame), and this is their common case (BENCHMARKS.md, packet section).
+template <typename R> inline bool keeps_one_sign(const CellCubic<R>& f) {
+    const R c0 = f.c[0], c1 = f.c[1], c2 = f.c[2], c3 = f.c[3];
+    const R b1 = c0 + c1 / R(3), b2 = c0 + (R(2) * c1 + c2) / R(3), b3 = ((c0 + c1) + c2) + c3;
+    const R margin = R(0x1p-40) * (std::fabs(c0) + std::fabs(c1) + std::fabs(c2) + std::fabs(c3));
+    const R lo = std::min(std::min(c0, b1), std::min(b2, b3)), hi = std::max(std::max(c0, b1), std::max(b2, b3));
+    if (lo > margin) return f.f_out > 0;
+    if (hi < -margin) return f.f_out < 0;
+    return false;
+}
+
 /// s of a root inside the bracket [a, b] where f(b) != 0: the true root is < b, so a value that
 /// rounded up to b (or beyond) is pulled just below it; the half-open rule stays exact.
 inline double into_bracket(double s, double a, double b) {
@@ -265,22 +285,14 @@ struct Exact {
 ///     that does not reach iso is not;
 ///   - a root exactly at s = 1 (f_out == 0) belongs to the next cell unless closed_end.
 /// Pure function of its arguments; thread-safe.
+/// Marmitt's walk over the monotone pieces between stationary points of a built cubic `f`
+/// (f_in != 0, a segment of non-zero length): the first piece with a sign change holds exactly one
+/// root, the first root. Signs are compared, never multiplied (E12). first_root without its
+/// early exit (roots_detail::keeps_one_sign), which a test holds to the same results.
 template <class Finder>
-inline double first_root(const Finder& finder, const double corner[8], double iso, const std::array<double, 3>& p_in,
-                         const std::array<double, 3>& p_out, bool closed_end) {
+inline double marmitt_walk(const Finder& finder, const CellCubic<typename Finder::Real>& f, bool closed_end) {
     using R = typename Finder::Real;
     using roots_detail::sign;
-    bool finite = std::isfinite(iso);
-    for (int i = 0; i < 8; ++i) finite &= std::isfinite(corner[i]);
-    for (int a = 0; a < 3; ++a) finite &= std::isfinite(p_in[a]) && std::isfinite(p_out[a]);
-    if (!finite) return kNoHit;
-
-    const CellCubic<R> f = make_cell_cubic<R>(corner, iso, p_in, p_out);
-    if (p_in == p_out) return closed_end && f.f_in == 0 ? 0.0 : kNoHit;
-    if (f.f_in == 0) return 0.0;
-
-    // Marmitt: walk the monotone pieces between stationary points; the first with a sign change
-    // holds exactly one root, the first root. Signs are compared, never multiplied (E12).
     R ext[2];
     const int n = finder.extrema(f, ext);
     R a = 0, fa = f.f_in;
@@ -295,6 +307,23 @@ inline double first_root(const Finder& finder, const double corner[8], double is
     if (sign(f.f_out) != sign(fa))
         return roots_detail::into_bracket(double(finder.refine(f, a, fa, R(1), f.f_out)), double(a), 1.0);
     return kNoHit;
+}
+
+template <class Finder>
+inline double first_root(const Finder& finder, const double corner[8], double iso, const std::array<double, 3>& p_in,
+                         const std::array<double, 3>& p_out, bool closed_end) {
+    using R = typename Finder::Real;
+    bool finite = std::isfinite(iso);
+    for (int i = 0; i < 8; ++i) finite &= std::isfinite(corner[i]);
+    for (int a = 0; a < 3; ++a) finite &= std::isfinite(p_in[a]) && std::isfinite(p_out[a]);
+    if (!finite) return kNoHit;
+
+    const CellCubic<R> f = make_cell_cubic<R>(corner, iso, p_in, p_out);
+    if (p_in == p_out) return closed_end && f.f_in == 0 ? 0.0 : kNoHit;
+    if (f.f_in == 0) return 0.0;
+    // 0.94-0.96 x the frame time (min of 5 interleaved pairs; build_ab_bernstein_exit.json).
+    if (roots_detail::keeps_one_sign(f)) return kNoHit;
+    return marmitt_walk(finder, f, closed_end);
 }
 
 /// Calls f(finder) with a value of the policy type for `kind`, once, outside the hot loop, so

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <type_traits>
@@ -478,6 +479,68 @@ TYPED_TEST(RootFinder, E16_SliverThroughAnEdgeReportedByExactlyOneCell) {
 }
 
 // ---------------------------------------------------------------------------------------------
+/// first_root's early exit (keeps_one_sign: a one-signed Bernstein hull) returns what the walk it
+/// skips returns, bit for bit, for every finder: on uniform random cells, on near-tangent ones (the
+/// isovalue within a few ulps of the value at a stationary point, where a walk's rounding could see
+/// a sign change) and on cells whose hull clears zero by a hair around the exit's margin (the
+/// isovalue just below the smallest or above the largest Bernstein coefficient). The exit must
+/// fire on random and on hull-edge cells (not a vacuous check).
+TYPED_TEST(RootFinder, EarlyExitReturnsWhatTheWalkReturns) {
+    using R = typename TypeParam::Real;
+    std::mt19937_64 rng(19980101);
+    std::uniform_real_distribution<double> u01(0, 1), usym(-1, 1);
+    int fired = 0, fired_at_edge = 0, cases = 0;
+    auto check = [&](const Seg& g, bool at_edge) {
+        const CellCubic<R> f = make_cell_cubic<R>(g.corner, g.iso, g.p_in, g.p_out);
+        if (g.p_in == g.p_out || f.f_in == 0) return;
+        ++cases;
+        const double walked = marmitt_walk(TypeParam{}, f, false);
+        const double s = first_root(TypeParam{}, g.corner, g.iso, g.p_in, g.p_out, false);
+        ASSERT_EQ(std::memcmp(&walked, &s, sizeof s), 0) << "case " << cases << ": walk " << walked << ", first_root " << s;
+        if (roots_detail::keeps_one_sign(f)) {
+            ASSERT_LT(walked, 0) << "the hull is one-signed, yet the walk hits, case " << cases;
+            ++fired;
+            fired_at_edge += at_edge;
+        }
+    };
+    for (int n = 0; n < 20000; ++n) {
+        Seg g;
+        double lo = 1e300, hi = -1e300;
+        for (double& c : g.corner) c = usym(rng), lo = std::min(lo, c), hi = std::max(hi, c);
+        g.iso = lo + (hi - lo) * u01(rng);
+        for (int a = 0; a < 3; ++a) g.p_in[a] = u01(rng), g.p_out[a] = u01(rng);
+        check(g, false);
+        // Near-tangent: iso at the field's value at a stationary point of the segment, nudged by ulps.
+        const CellCubic<double> f0 = make_cell_cubic<double>(g.corner, 0.0, g.p_in, g.p_out);
+        double ext[2];
+        const int m = roots_detail::extrema_stable(f0, ext);
+        for (int i = 0; i < m; ++i) {
+            P3 p;
+            for (int a = 0; a < 3; ++a) p[a] = g.p_in[a] + ext[i] * (g.p_out[a] - g.p_in[a]);
+            const double v = trilinear(g.corner, p);
+            for (double k : {0.0, 1.0, -1.0, 8.0, -8.0, 4096.0, -4096.0}) {
+                Seg t = g;
+                t.iso = v + k * std::ldexp(std::fabs(v) + 1e-300, -52);
+                check(t, false);
+            }
+        }
+        // Hull edge: the Bernstein coefficients of f - iso are those of f shifted by iso (scaled).
+        const double b[4] = {f0.c[0], f0.c[0] + f0.c[1] / 3, f0.c[0] + (2 * f0.c[1] + f0.c[2]) / 3,
+                             ((f0.c[0] + f0.c[1]) + f0.c[2]) + f0.c[3]};
+        const double scale = std::ldexp(1.0, f0.scale_exp);
+        for (double edge : {*std::min_element(b, b + 4), *std::max_element(b, b + 4)})
+            for (double gap : {1e-16, 1e-14, 1e-13, 1e-12, 1e-11, 1e-9}) {
+                Seg t = g;
+                t.iso = (edge - gap) * scale;
+                check(t, true);
+                t.iso = (edge + gap) * scale;
+                check(t, true);
+            }
+    }
+    EXPECT_GT(fired, cases / 10) << "the early exit should take a good share of random cells";
+    EXPECT_GT(fired_at_edge, 1000);
+}
+
 TEST(RootFinderReference, ExactMatchesIndependentFloat128Reference) {
     std::mt19937_64 rng(20060101);
     std::uniform_real_distribution<double> u01(0, 1), usym(-1, 1);
