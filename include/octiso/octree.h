@@ -326,13 +326,46 @@ public:
     /// The same, returning where the descent ended (the traversal then reads a whole forward
     /// neighbour block directly).
     OCTISO_ALWAYS_INLINE LeafRef<T> neighbour_locate(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
+        const TracedNode from = common_ancestor(start, dest, depth, parent_trace);
+        return locate_from(dest, from.depth, from.index);
+    }
+
+    /// A node on a parent trace: its depth and its index there.
+    struct TracedNode {
+        int depth;
+        uint32_t index;
+    };
+    /// The deepest node of the trace (as for neighbour_find) whose cube also contains `dest`:
+    /// where every search from `start` for `dest` begins (the root when none deeper does).
+    OCTISO_ALWAYS_INLINE TracedNode common_ancestor(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
         for (int d = depth; d > 0; --d) {
             const int shift = a_.dmax - d;   // cube side of a depth-d node is 2^shift
             if (((start.x ^ dest.x) >> shift) == 0 && ((start.y ^ dest.y) >> shift) == 0 &&
                 ((start.z ^ dest.z) >> shift) == 0)
-                return locate_from(dest, d, parent_trace[d]);
+                return {d, parent_trace[d]};
         }
-        return locate_from(dest, 0, 0);
+        return {0, 0};
+    }
+
+    /// Where a descent towards `dest` ends at depth `target`: the node there whose cube holds
+    /// dest, or, where a scalar leaf above that depth covers dest, the leaf's value.
+    struct NodeAt {
+        bool is_leaf;
+        uint32_t index;   ///< !is_leaf: the node at depth `target`
+        T value;          ///< is_leaf: the leaf's value
+    };
+    /// The node at depth `target` (depth <= target <= dmax-2) holding `dest`, found from the trace
+    /// as neighbour_locate finds a voxel: the traversal's forward neighbours of a cap parent,
+    /// located once for all the caps of that parent that need them.
+    OCTISO_ALWAYS_INLINE NodeAt node_at(Coord start, Coord dest, int depth, const uint32_t* parent_trace, int target) const {
+        TracedNode at = common_ancestor(start, dest, depth, parent_trace);
+        for (; at.depth < target; ++at.depth) {
+            const InteriorNode<T>& n = a_.nodes[size_t(at.depth)][at.index];
+            const int c = octant_of(dest, child_bit(at.depth));
+            if (n.is_scalar_leaf(c)) return {true, 0, n.scalar[c]};
+            at.index = child_index(at.depth, at.index, n, c);
+        }
+        return {false, at.index, T{}};
     }
 
     /// Level of detail (issue 14): the voxel at `q` where q is a multiple of `unit` (a power of
@@ -341,16 +374,9 @@ public:
     /// record, a scalar leaf holds it outright. So a coarse lattice of spacing `unit` touches
     /// only the levels above it. `start`, `depth`, `parent_trace` as for neighbour_locate.
     OCTISO_ALWAYS_INLINE T lattice_value(Coord start, Coord q, uint32_t unit, int depth, const uint32_t* parent_trace) const {
-        int d = 0;
-        uint32_t index = 0;
-        for (int k = depth; k > 0; --k) {
-            const int shift = a_.dmax - k;
-            if (((start.x ^ q.x) >> shift) == 0 && ((start.y ^ q.y) >> shift) == 0 && ((start.z ^ q.z) >> shift) == 0) {
-                d = k;
-                index = parent_trace[k];
-                break;
-            }
-        }
+        const TracedNode from = common_ancestor(start, q, depth, parent_trace);
+        int d = from.depth;
+        uint32_t index = from.index;
         const int cap_parents_at = a_.dmax - 2;
         for (;;) {
             const InteriorNode<T>& n = a_.nodes[size_t(d)][index];

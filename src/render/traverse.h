@@ -215,6 +215,7 @@ private:
         const uint64_t first = tree_.first_child(d, index, n);
         const uint32_t half = tree_.child_bit(d);
         if constexpr (Recorder::kOn) recorder_.enter_node(d, index, o, 2 * half, t0, t1);
+        CapParent parent(n, first);   // used only at depth dmax-2
         bool hit = false;
         for_each_child_piece(w.ray, o, half, t0, t1, [&](int c, double t_cur, double t_next) {
             if constexpr (Recorder::kOn)
@@ -233,7 +234,7 @@ private:
             }
             if (n.is_scalar_leaf(c)) hit = scalar_leaf(w, w.trace, d, co, half, n.scalar[c], t_cur, t_next);
             else if (d == tree_.dmax() - 2) {
-                CapBlocks blocks;
+                CapBlocks blocks(parent, c);
                 hit = cap(w, w.trace, tree_.cap_at(first, n, c), co, t_cur, t_next, blocks);
             } else hit = node(w, d + 1, tree_.child_index_at(first, n, c), co, t_cur, t_next);
             return hit;
@@ -283,9 +284,30 @@ private:
     /// block, 2 of an edge block, 1 of the corner block). One per cap visit; a packet shares it
     /// between its lanes, so each voxel is decoded once per packet instead of once per corner per
     /// lane (BENCHMARKS.md, packet section: the lattice A/B).
+    /// A cap parent (depth dmax-2, side 4) and its forward neighbours at the same depth: entry q
+    /// (octant bits) is the node whose cube holds the parent's origin + 4 (q>>2&1, q>>1&1, q&1),
+    /// or the scalar leaf above that depth covering it; entry 0 is the parent itself. Entries are
+    /// located on first use and shared by every cap of the parent that a ray or a packet visits:
+    /// a cap's forward block outside its parent is a child of one of them, so it is read directly
+    /// instead of by a climb and descent per block: 0.93-1.01 x the frame time (min of 5 pairs,
+    /// medians 0.95-0.98; build_ab_cap_parent.json, BENCHMARKS.md packet section).
+    struct CapParent {
+        const InteriorNode<T>* node[8];   ///< entries in `ready` and not in `is_leaf`
+        uint64_t first[8];                ///< their first children (byte offsets into the caps)
+        T leaf[8];                        ///< entries in `is_leaf`: the covering leaf's value
+        unsigned ready = 1, is_leaf = 0;
+        CapParent(const InteriorNode<T>& n, uint64_t first_child) {
+            node[0] = &n;
+            first[0] = first_child;
+        }
+    };
+
     struct CapBlocks {
         double lattice[27];   ///< unset until its block's bit is in `ready`
         unsigned ready = 0;   ///< bit r: block r's lattice voxels are in place
+        CapParent& parent;    ///< the cap's parent and its neighbours
+        int octant;           ///< the cap's octant in its parent
+        CapBlocks(CapParent& p, int c) : parent(p), octant(c) {}
     };
 
     /// One packet of rays sharing their direction signs: per lane its walk, its piece [t0, t1) of
@@ -413,6 +435,7 @@ private:
         const uint32_t half = tree_.child_bit(d);
         PacketSplit split;
         split.split(*this, p, o, half, active, t0, t1);
+        CapParent parent(n, first);   // used only at depth dmax-2
         for (int i = 0; i < 8 && active; ++i) {
             const unsigned c = unsigned(i ^ flip);
             if (!n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
@@ -443,7 +466,7 @@ private:
                     if (scalar_leaf(p.lane[k], p.trace, d, co, half, n.scalar[c], c0[k], c1[k])) hit |= 1u << k;
                 }
             } else if (d == tree_.dmax() - 2) {
-                CapBlocks blocks;   // located once for every lane that crosses this cap
+                CapBlocks blocks(parent, int(c));   // located once for every lane that crosses this cap
                 const CapRef<T> ci = tree_.cap_at(first, n, int(c));
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
@@ -472,17 +495,42 @@ private:
         return m;
     }
 
-    /// Puts the lattice voxels of the blocks in `missing` into `blocks` (CapBlocks).
+    /// Locates entry q of `parent` (CapParent), the cap parent holding `co`, from its trace.
+    [[gnu::noinline]] void locate_cap_parent(CapParent& parent, int q, const Coord& co, const uint32_t* trace) const {
+        const int parent_depth = tree_.dmax() - 2;
+        const Coord dest{(co.x & ~3u) + ((q & 4) ? 4u : 0u), (co.y & ~3u) + ((q & 2) ? 4u : 0u), (co.z & ~3u) + ((q & 1) ? 4u : 0u)};
+        const auto at = tree_.node_at(co, dest, parent_depth, trace, parent_depth);
+        if (at.is_leaf) {
+            parent.is_leaf |= 1u << q;
+            parent.leaf[q] = at.value;
+        } else {
+            const InteriorNode<T>& n = tree_.node(parent_depth, at.index);
+            parent.node[q] = &n;
+            parent.first[q] = tree_.first_child(parent_depth, at.index, n);
+        }
+        parent.ready |= 1u << q;
+    }
+
+    /// Puts the lattice voxels of the blocks in `missing` into `blocks` (CapBlocks). Block r of the
+    /// cap at octant c of its parent is child c ^ r of parent entry c & r: on the axes of r where c
+    /// is already on the upper side, the block lies across the parent's face.
     [[gnu::noinline]] void fill_cap_blocks(CapBlocks& blocks, unsigned missing, const CapRef<T>& ref, const Coord& co,
                                          const uint32_t* trace) const {
-        const int parent_depth = tree_.dmax() - 2;
+        CapParent& parent = blocks.parent;
+        const int c = blocks.octant;
         for (unsigned m = missing; m; m &= m - 1) {
             const int r = std::countr_zero(m);
             LeafRef<T> found{T{}, true, ref, 0};
             if (r != 0) {
-                // Outside this cap, so the climb starts at its parent (octree.h).
-                const Coord b{co.x + ((r & 4) ? 2u : 0u), co.y + ((r & 2) ? 2u : 0u), co.z + ((r & 1) ? 2u : 0u)};
-                found = tree_.neighbour_locate(co, b, parent_depth, trace);
+                const int q = c & r, oct = c ^ r;
+                if (!((parent.ready >> q) & 1u)) locate_cap_parent(parent, q, co, trace);
+                if ((parent.is_leaf >> q) & 1u) {
+                    found = {parent.leaf[q], false, {}, 0};
+                } else {
+                    const InteriorNode<T>& n = *parent.node[q];
+                    found = n.is_scalar_leaf(oct) ? LeafRef<T>{n.scalar[oct], false, {}, 0}
+                                                  : LeafRef<T>{T{}, true, tree_.cap_at(parent.first[q], n, oct), 0};
+                }
             }
             // The block's lattice voxels: 2 on the axes of r (its local 0), 0 or 1 on the others.
             for (int local = 0; local < 8; ++local) {
