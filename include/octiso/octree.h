@@ -74,9 +74,10 @@ inline constexpr uint64_t kCapReadSlack = 8;
 /// child. 1-byte scalars: the exact min/max (4-bit codes, tried for format 5, made u8 frames
 /// 0.84-0.99 x as fast for 6 % of raw less on plume; BENCHMARKS.md "The compact octree, format
 /// 5"). Wider ones: 8-bit codes inside [lo, hi], the exact range of the node's children
-/// together, in steps of s = hi/255 - lo/255 (finite for every double range): a lower code q stands for lo + q s (0: lo exactly), an upper code q for
-/// hi - (255 - q) s (255: hi exactly). No branch and no select in the decode (the first version,
-/// 0 and 255 as special cases, cost packet_node 19 %, perf on Marschner-Lobb 256^3). The packer
+/// together, in steps of s = hi/255 - lo/255 (finite for every double range): a lower code q
+/// stands for lo + q s (0: lo exactly), an upper code q for hi - (255 - q) s (255: hi exactly).
+/// No branch and no select in the decode (the first version, 0 and 255 as special cases, cost
+/// packet_node 19 %, perf on Marschner-Lobb 256^3). The packer
 /// picks the largest lower and smallest upper code that still contain the true range (it runs
 /// this same decode), and qmin > qmax marks an empty child.
 template <typename T, bool kExact = (sizeof(T) == 1)> struct ChildBounds;

@@ -54,21 +54,27 @@ template <typename R> inline int extrema_stable(const CellCubic<R>& f, R out[2])
     return quadratic_roots_in_unit(R(3) * f.c[3], R(2) * f.c[2], f.c[1], out);
 }
 
-/// Whether the walk below would find no root on [0, 1] whatever the finder: true only where the
-/// cubic's Bernstein coefficients on [0, 1] (whose hull bounds it there) all exceed, with one
-/// sign, a margin far above the rounding of any evaluation the walk makes, and f_out (evaluated
-/// apart, from the corners) is non-zero with that sign. Then f(e) at every stationary point a
-/// finder returns keeps the sign of f_in, so the walk would end in kNoHit: the same result
-/// without the stationary points (a square root, divisions) and their evaluations.
+/// The cubic's Bernstein coefficients on [0, 1]: f(s) = sum b_i C(3,i) s^i (1-s)^(3-i), so on
+/// [0, 1] f lies between the least and the largest of them.
+template <typename R> inline std::array<R, 4> bernstein_on_unit(const CellCubic<R>& f) {
+    const R c0 = f.c[0], c1 = f.c[1], c2 = f.c[2], c3 = f.c[3];
+    return {c0, c0 + c1 / R(3), c0 + (R(2) * c1 + c2) / R(3), ((c0 + c1) + c2) + c3};
+}
+
+/// Whether the walk (marmitt_walk) would find no root on [0, 1] whatever the finder: true only
+/// where the Bernstein coefficients all exceed, with one sign, a margin far above the rounding of
+/// any evaluation the walk makes, and f_out (evaluated apart, from the corners) is non-zero with
+/// that sign. Then f(e) at every stationary point a finder returns keeps the sign of f_in, so the
+/// walk would end in kNoHit: the same result without the stationary points (a square root,
+/// divisions) and their evaluations.
 /// Margin: the hull and Horner's f(e) on [0, 1] each round by under 8u (|c0| + .. + |c3|),
 /// u = 2^-53 for double (less for long double); 2^-40 of that sum is over 100 times more.
 /// Most cells whose corner range holds the isovalue are not hit (ch2better 100.5: 118 k of 166 k
-/// per 512^2 frame), and this is their common case (BENCHMARKS.md, packet section).
+/// per 512^2 frame, counted once, no JSON), and this is their common case (BENCHMARKS.md, packets).
 template <typename R> inline bool keeps_one_sign(const CellCubic<R>& f) {
-    const R c0 = f.c[0], c1 = f.c[1], c2 = f.c[2], c3 = f.c[3];
-    const R b1 = c0 + c1 / R(3), b2 = c0 + (R(2) * c1 + c2) / R(3), b3 = ((c0 + c1) + c2) + c3;
-    const R margin = R(0x1p-40) * (std::fabs(c0) + std::fabs(c1) + std::fabs(c2) + std::fabs(c3));
-    const R lo = std::min(std::min(c0, b1), std::min(b2, b3)), hi = std::max(std::max(c0, b1), std::max(b2, b3));
+    const auto [b0, b1, b2, b3] = bernstein_on_unit(f);
+    const R margin = R(0x1p-40) * (std::fabs(f.c[0]) + std::fabs(f.c[1]) + std::fabs(f.c[2]) + std::fabs(f.c[3]));
+    const R lo = std::min(std::min(b0, b1), std::min(b2, b3)), hi = std::max(std::max(b0, b1), std::max(b2, b3));
     if (lo > margin) return f.f_out > 0;
     if (hi < -margin) return f.f_out < 0;
     return false;
@@ -273,18 +279,6 @@ struct Exact {
     }
 };
 
-/// First root s in [0,1) (in [0,1] when closed_end) of trilinear(p_in + s (p_out - p_in)) - iso,
-/// where p_in, p_out are cell-local; kNoHit if none. Never NaN. The hit policies (CONVENTIONS 2b),
-/// the same for every Finder (Linear misses even crossings by design):
-///   - any non-finite corner, iso or endpoint: no hit (the caller continues behind the cell);
-///   - a zero-length segment (p_in == p_out: the ray grazes an edge or corner) is the empty [0,0)
-///     unless closed_end, then the point s = 0 if f == iso exactly there; so among the cells that
-///     share that edge only the one that owns the half-open piece starting there reports it;
-///   - f == iso exactly at p_in (includes a cell identically iso along the segment): s = 0;
-///   - a stationary point e where f(e) == iso exactly is a hit (tangential touch), a near touch
-///     that does not reach iso is not;
-///   - a root exactly at s = 1 (f_out == 0) belongs to the next cell unless closed_end.
-/// Pure function of its arguments; thread-safe.
 /// Marmitt's walk over the monotone pieces between stationary points of a built cubic `f`
 /// (f_in != 0, a segment of non-zero length): the first piece with a sign change holds exactly one
 /// root, the first root. Signs are compared, never multiplied (E12). first_root without its
@@ -309,6 +303,18 @@ inline double marmitt_walk(const Finder& finder, const CellCubic<typename Finder
     return kNoHit;
 }
 
+/// First root s in [0,1) (in [0,1] when closed_end) of trilinear(p_in + s (p_out - p_in)) - iso,
+/// where p_in, p_out are cell-local; kNoHit if none. Never NaN. The hit policies (CONVENTIONS 2b),
+/// the same for every Finder (Linear misses even crossings by design):
+///   - any non-finite corner, iso or endpoint: no hit (the caller continues behind the cell);
+///   - a zero-length segment (p_in == p_out: the ray grazes an edge or corner) is the empty [0,0)
+///     unless closed_end, then the point s = 0 if f == iso exactly there; so among the cells that
+///     share that edge only the one that owns the half-open piece starting there reports it;
+///   - f == iso exactly at p_in (includes a cell identically iso along the segment): s = 0;
+///   - a stationary point e where f(e) == iso exactly is a hit (tangential touch), a near touch
+///     that does not reach iso is not;
+///   - a root exactly at s = 1 (f_out == 0) belongs to the next cell unless closed_end.
+/// Pure function of its arguments; thread-safe.
 template <class Finder>
 inline double first_root(const Finder& finder, const double corner[8], double iso, const std::array<double, 3>& p_in,
                          const std::array<double, 3>& p_out, bool closed_end) {

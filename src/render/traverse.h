@@ -276,14 +276,6 @@ private:
         return false;
     }
 
-    /// The corner lattice of one cap: the 3x3x3 voxels that its 8 cells' corners are, at
-    /// lattice[9 x + 3 y + z] (x, y, z = 0..2 from the cap's origin), filled block by block on
-    /// first use and then read directly. Block 0 is the cap itself; block r = 1..7 (octant bits) is
-    /// its forward neighbour 2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), a cap or part of one scalar
-    /// leaf, located by neighbour finding; only its voxels on the lattice are decoded (4 of a face
-    /// block, 2 of an edge block, 1 of the corner block). One per cap visit; a packet shares it
-    /// between its lanes, so each voxel is decoded once per packet instead of once per corner per
-    /// lane (BENCHMARKS.md, packet section: the lattice A/B).
     /// A cap parent (depth dmax-2, side 4) and its forward neighbours at the same depth: entry q
     /// (octant bits) is the node whose cube holds the parent's origin + 4 (q>>2&1, q>>1&1, q&1),
     /// or the scalar leaf above that depth covering it; entry 0 is the parent itself. Entries are
@@ -302,6 +294,14 @@ private:
         }
     };
 
+    /// The corner lattice of one cap: the 3x3x3 voxels that its 8 cells' corners are, at
+    /// lattice[9 x + 3 y + z] (x, y, z = 0..2 from the cap's origin), filled block by block on
+    /// first use and then read directly. Block 0 is the cap itself; block r = 1..7 (octant bits) is
+    /// its forward neighbour 2x2x2 at co + 2 * (r>>2&1, r>>1&1, r&1), a cap or part of one scalar
+    /// leaf, located by neighbour finding; only its voxels on the lattice are decoded (4 of a face
+    /// block, 2 of an edge block, 1 of the corner block). One per cap visit; a packet shares it
+    /// between its lanes, so each voxel is decoded once per packet instead of once per corner per
+    /// lane (BENCHMARKS.md, packet section: the lattice A/B).
     struct CapBlocks {
         double lattice[27];   ///< unset until its block's bit is in `ready`
         unsigned ready = 0;   ///< bit r: block r's lattice voxels are in place
@@ -637,15 +637,23 @@ private:
                          scene_.box_hi};
         return walk_units(w.ray, UnitCells{}, box, t0, t1, w.t_exit,
                           [&](const int64_t cell[3], double t_in, double t_out, bool closed_end) OCTISO_LAMBDA_INLINE {
-                              if (cell[0] > last_cell[0] || cell[1] > last_cell[1] || cell[2] > last_cell[2])
-                                  return false;
-                              OCTISO_DCHECK(cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0, "cell below the data box");
-                              if (partial && !owns_cell(cell)) [[unlikely]] return false;
-                              const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
-                              double corner[8];
-                              gather(v, corner);
-                              return test_cell(w, v, corner, t_in, t_out, closed_end);
+                              return visit_cell(w, cell, t_in, t_out, closed_end, partial, gather);
                           });
+    }
+
+    /// One cell of a walk (walk_cells, walk_cap_cells) on its piece [t_in, t_out): stepped over
+    /// beyond the last data cell (padding) or outside the owned cells, else gathered and tested.
+    template <class Gather>
+    OCTISO_ALWAYS_INLINE bool visit_cell(RayState& w, const int64_t cell[3], double t_in, double t_out, bool closed_end,
+                                         bool partial, Gather& gather) const {
+        const Dims dims = tree_.dims();
+        if (cell[0] > int64_t(dims.x) - 2 || cell[1] > int64_t(dims.y) - 2 || cell[2] > int64_t(dims.z) - 2) return false;
+        OCTISO_DCHECK(cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0, "cell below the data box");
+        if (partial && !owns_cell(cell)) [[unlikely]] return false;
+        const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
+        double corner[8];
+        gather(v, corner);
+        return test_cell(w, v, corner, t_in, t_out, closed_end);
     }
 
     /// The cells of the cap [co, co + 2)^3 that the ray crosses on [t0, t1), in order, as
@@ -658,18 +666,10 @@ private:
     /// a noisier machine read 0.87-1.13, build_ab_cap_split.json).
     template <class Gather>
     bool walk_cap_cells(RayState& w, const Coord& co, double t0, double t1, bool partial, Gather&& gather) const {
-        const Dims dims = tree_.dims();
         return for_each_child_piece(w.ray, co, 1, t0, t1, [&](int c, double t_in, double t_out) OCTISO_LAMBDA_INLINE {
             const Coord v = child_origin_of(co, c, 1);
-            // Beyond the last data cell (padding): stepped over, as walk_cells does.
-            if (v.x + 2 > dims.x || v.y + 2 > dims.y || v.z + 2 > dims.z) return false;
-            if (partial) [[unlikely]] {
-                const int64_t cell[3] = {v.x, v.y, v.z};
-                if (!owns_cell(cell)) return false;
-            }
-            double corner[8];
-            gather(v, corner);
-            return test_cell(w, v, corner, t_in, t_out, t_out == w.t_exit);
+            const int64_t cell[3] = {v.x, v.y, v.z};
+            return visit_cell(w, cell, t_in, t_out, t_out == w.t_exit, partial, gather);
         });
     }
 

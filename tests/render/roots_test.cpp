@@ -525,10 +525,9 @@ TYPED_TEST(RootFinder, EarlyExitReturnsWhatTheWalkReturns) {
             }
         }
         // Hull edge: the Bernstein coefficients of f - iso are those of f shifted by iso (scaled).
-        const double b[4] = {f0.c[0], f0.c[0] + f0.c[1] / 3, f0.c[0] + (2 * f0.c[1] + f0.c[2]) / 3,
-                             ((f0.c[0] + f0.c[1]) + f0.c[2]) + f0.c[3]};
+        const std::array<double, 4> b = roots_detail::bernstein_on_unit(f0);
         const double scale = std::ldexp(1.0, f0.scale_exp);
-        for (double edge : {*std::min_element(b, b + 4), *std::max_element(b, b + 4)})
+        for (double edge : {*std::min_element(b.begin(), b.end()), *std::max_element(b.begin(), b.end())})
             for (double gap : {1e-16, 1e-14, 1e-13, 1e-12, 1e-11, 1e-9}) {
                 Seg t = g;
                 t.iso = (edge - gap) * scale;
