@@ -8,7 +8,11 @@ same pixels (idiff -fail 0: a change meant to keep the image must).
 
     scripts/build_ab.py --a /work/wt-old/build/octiso-render [--b build/octiso-render] [--pairs 5]
                         [--threads 1] [--size 512x512] [--orbit 8] [--flags '--no-embree']
-                        [--results DIR] [--tag NAME] FILE.oct[,B_FILE.oct]@ISO ...
+                        [--colour] [--phase trace|shade] [--results DIR] [--tag NAME] FILE.oct[,B_FILE.oct]@ISO ...
+
+--colour also writes the colour image and compares it; --phase shade times the shading pass instead
+of the tile loop: with --colour --flags '--no-embree --ao 4' that is the ambient-occlusion rays,
+single rays from the hits in random directions (the renderer's incoherent rays).
 
 FILE.oct,B_FILE.oct: a format change, each build on its own conversion of the same voxels (A on FILE,
 B on B_FILE); the images are compared all the same.
@@ -24,20 +28,24 @@ import subprocess
 import tempfile
 
 
+def kinds(a):
+    return [("depth", "exr"), ("normal", "exr")] + ([("colour", "png")] if a.colour else [])
+
+
 def render(binary, path, iso, a, outdir, tag):
-    depth = os.path.join(outdir, f"{tag}_depth_%d.exr")
-    normal = os.path.join(outdir, f"{tag}_normal_%d.exr")
-    cmd = [binary, path, "--iso", iso, "--depth", depth, "--normal", normal, "--orbit", str(a.orbit),
-           "--threads", str(a.threads), "--size", a.size, "--json"] + a.flags.split()
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    outputs = {"depth": "--depth", "normal": "--normal", "colour": "-o"}
+    cmd = [binary, path, "--iso", iso, "--orbit", str(a.orbit), "--threads", str(a.threads), "--size", a.size, "--json"]
+    for kind, ext in kinds(a):
+        cmd += [outputs[kind], os.path.join(outdir, f"{tag}_{kind}_%d.{ext}")]
+    out = subprocess.run(cmd + a.flags.split(), check=True, capture_output=True, text=True).stdout
     frames = json.loads(out)["frames"]
-    return sum(f["phases"]["trace"] for f in frames) / len(frames)
+    return sum(f["phases"][a.phase] for f in frames) / len(frames)
 
 
-def same_pixels(outdir, orbit):
-    for kind in ("depth", "normal"):
-        for i in range(orbit):
-            pa, pb = (os.path.join(outdir, f"{t}_{kind}_{i}.exr") for t in ("A", "B"))
+def same_pixels(outdir, a):
+    for kind, ext in kinds(a):
+        for i in range(a.orbit):
+            pa, pb = (os.path.join(outdir, f"{t}_{kind}_{i}.{ext}") for t in ("A", "B"))
             if subprocess.run(["idiff", "-fail", "0", "-warn", "0", pa, pb], capture_output=True).returncode != 0:
                 return False
     return True
@@ -53,6 +61,8 @@ def main():
     p.add_argument("--size", default="512x512")
     p.add_argument("--orbit", type=int, default=8)
     p.add_argument("--flags", default="--no-embree")
+    p.add_argument("--colour", action="store_true", help="also write and compare the colour image")
+    p.add_argument("--phase", default="trace", choices=["trace", "shade"], help="the phase timed (phases of --json)")
     p.add_argument("--results")
     p.add_argument("--tag", default="", help="the JSON is build_ab_TAG.json")
     a = p.parse_args()
@@ -68,7 +78,7 @@ def main():
                 order = ("A", "B") if pair % 2 == 0 else ("B", "A")
                 for tag in order:
                     t[tag].append(render(a.a if tag == "A" else a.b, path if tag == "A" else b_path, iso, a, outdir, tag))
-            same = same_pixels(outdir, a.orbit)
+            same = same_pixels(outdir, a)
             row = {"file": path, "b_file": b_path, "iso": float(iso), "a_seconds": t["A"], "b_seconds": t["B"],
                    "b_over_a_min": min(t["B"]) / min(t["A"]),
                    "b_over_a_median": statistics.median(t["B"]) / statistics.median(t["A"]), "same_pixels": same}
@@ -81,7 +91,7 @@ def main():
     out = os.path.join(results, f"build_ab_{a.tag}.json" if a.tag else "build_ab.json")
     with open(out, "w") as f:
         json.dump({"a": a.a, "b": a.b, "pairs": a.pairs, "threads": a.threads, "size": a.size, "orbit": a.orbit,
-                   "flags": a.flags, "machine": platform.processor() or platform.machine(), "rows": rows}, f, indent=1)
+                   "flags": a.flags, "phase": a.phase, "colour": a.colour, "machine": platform.processor() or platform.machine(), "rows": rows}, f, indent=1)
     print(f"JSON: {out}")
     return 0 if all(r["same_pixels"] for r in rows) else 1
 
