@@ -33,6 +33,7 @@
 #include "render/cell.h"
 #include "render/cell_dda.h"
 #include "render/cell_hit.h"
+#include "render/live_children.h"
 #include "render/lod.h"
 #include "math/ray.h"
 #include "render/roots.h"
@@ -77,8 +78,8 @@ class OctreeTracer {
 public:
     OctreeTracer(const Octree<T>& tree, const Placement& placement, const double* isovalues, int iso_count,
                  const Finder& finder, const Corners& corners = Corners{}, const Recorder& recorder = Recorder{})
-        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), finder_(finder), corners_(corners),
-          recorder_(recorder) {
+        : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), live_(isovalues, iso_count), finder_(finder),
+          corners_(corners), recorder_(recorder) {
         OCTISO_CHECK(tree.dmax() >= 2 && tree.dmax() < kMaxDepth, "dmax ", tree.dmax());
     }
 
@@ -215,14 +216,18 @@ private:
         const uint64_t first = tree_.first_child(d, index, n);
         const uint32_t half = tree_.child_bit(d);
         if constexpr (Recorder::kOn) recorder_.enter_node(d, index, o, 2 * half, t0, t1);
+        const unsigned live = live_.of(n);
+        if (!live && !Recorder::kOn) return false;   // the recorder still lists the culls
         CapParent parent(n, first);   // used only at depth dmax-2
         bool hit = false;
         for_each_child_piece(w.ray, o, half, t0, t1, [&](int c, double t_cur, double t_next) {
+            const bool culled = !((live >> c) & 1u) || (!LiveChildren<T>::kExact &&
+                                                        !n.may_contain_any(c, scene_.isovalues, scene_.iso_count));
             if constexpr (Recorder::kOn)
-                if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count))
+                if (culled)
                     recorder_.cull(d, c, child_origin_of(o, c, half), half, n.bounds.lower(c), n.bounds.upper(c),
                                    t_cur, t_next);
-            if (!n.may_contain_any(c, scene_.isovalues, scene_.iso_count)) return false;
+            if (culled) return false;
             const Coord co = child_origin_of(o, c, half);
             if (restricted_ && !overlaps_owned(co, half)) return false;
             if (!restricted_ && lod_.on()) [[unlikely]] {
@@ -433,12 +438,14 @@ private:
         const InteriorNode<T>& n = tree_.node(d, index);
         const uint64_t first = tree_.first_child(d, index, n);
         const uint32_t half = tree_.child_bit(d);
+        const unsigned live = live_.of(n);
+        if (!live) return active;
         PacketSplit split;
         split.split(*this, p, o, half, active, t0, t1);
         CapParent parent(n, first);   // used only at depth dmax-2
-        for (int i = 0; i < 8 && active; ++i) {
-            const unsigned c = unsigned(i ^ flip);
-            if (!n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
+        for (unsigned m = in_visit_order(live, flip); m && active; m &= m - 1) {
+            const unsigned c = unsigned(std::countr_zero(m) ^ flip);
+            if (!LiveChildren<T>::kExact && !n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
             const unsigned entered = split.enter(c, active);
             if (!entered) continue;
             const double* c0 = split.lo(c);
@@ -485,6 +492,16 @@ private:
             active &= ~hit;
         }
         return active;
+    }
+
+    /// `mask` (bit c: child c) with bit c moved to bit c ^ flip, so that its set bits, lowest
+    /// first, are packet_node's visiting order: each set bit of flip swaps the halves of the
+    /// mask along that axis.
+    static unsigned in_visit_order(unsigned mask, int flip) {
+        if (flip & 4) mask = ((mask & 0x0Fu) << 4) | (mask >> 4);
+        if (flip & 2) mask = ((mask & 0x33u) << 2) | ((mask >> 2) & 0x33u);
+        if (flip & 1) mask = ((mask & 0x55u) << 1) | ((mask >> 1) & 0x55u);
+        return mask;
     }
 
     /// Blocks whose voxels a cell of octant `oct` of a cap reads: every block r with r & ~oct == 0.
@@ -781,6 +798,7 @@ private:
 
     const Octree<T> tree_;   // a view: cheap to copy, and no dangling reference to a temporary
     const CellWalkScene scene_;
+    const LiveChildren<T> live_;   ///< the per-node cull of all 8 children (1-byte scalars)
     const Finder finder_;
     int min_packet_lanes_ = kDefaultMinPacketLanes;
     mutable LodCut lod_;   ///< set_lod(): per frame, between frames

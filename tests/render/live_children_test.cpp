@@ -1,0 +1,55 @@
+// LiveChildren<T> (src/render/live_children.h): the byte-compare cull of a node's 8 children is
+// InteriorNode::may_contain_any for every child, bit for bit, on random and edge-case bounds
+// (empty children, 0 and 255, -128 and 127) and isovalue sets (integers, halves, values outside
+// the type's range, several at once); wider types hand every child to the per-child test.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "render/live_children.h"
+
+namespace octiso::test {
+namespace {
+
+template <typename T> void expect_same_cull(uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> byte(std::numeric_limits<T>::lowest(), std::numeric_limits<T>::max());
+    const double lowest = double(std::numeric_limits<T>::lowest()), top = double(std::numeric_limits<T>::max());
+    std::vector<double> candidates = {lowest - 3.5, lowest - 0.5, lowest, lowest + 0.5, top - 0.5, top, top + 0.5,
+                                      top + 7.25, 0.0, 0.5, -0.5, 100.5, 1e300, -1e300};
+    for (int trial = 0; trial < 20000; ++trial) {
+        std::vector<double> isos;
+        const int count = 1 + trial % kMaxIsovalues;
+        for (int i = 0; i < count; ++i) {
+            const int pick = int(rng() % 4);
+            isos.push_back(pick == 0   ? candidates[rng() % candidates.size()]
+                           : pick == 1 ? double(byte(rng))
+                                       : double(byte(rng)) + (pick == 2 ? 0.5 : 0.125));
+        }
+        InteriorNode<T> n{};
+        for (int c = 0; c < 8; ++c) {
+            T a = T(byte(rng)), b = T(byte(rng));
+            if (rng() % 5 == 0) a = b;                               // one value
+            if (rng() % 7 != 0 && a > b) std::swap(a, b);            // else empty (min > max) now and then
+            n.bounds.min[c] = a, n.bounds.max[c] = b;
+        }
+        const LiveChildren<T> live(isos.data(), count);
+        unsigned expected = 0;
+        for (int c = 0; c < 8; ++c) expected |= unsigned(n.may_contain_any(c, isos.data(), count)) << c;
+        ASSERT_EQ(live.of(n), expected) << "trial " << trial;
+    }
+}
+
+TEST(LiveChildren, U8MatchesThePerChildTest) { expect_same_cull<uint8_t>(11); }
+TEST(LiveChildren, I8MatchesThePerChildTest) { expect_same_cull<int8_t>(12); }
+
+TEST(LiveChildren, WiderTypesLeaveEveryChildToThePerChildTest) {
+    const double iso = 1.5;
+    EXPECT_FALSE(LiveChildren<int16_t>::kExact);
+    EXPECT_FALSE(LiveChildren<float>::kExact);
+    EXPECT_EQ(LiveChildren<float>(&iso, 1).of(InteriorNode<float>{}), 0xFFu);
+}
+
+}  // namespace
+}  // namespace octiso::test
