@@ -61,7 +61,9 @@ struct RenderOptions {
     Traversal traversal = Traversal::packets;
     Isa isa = Isa::automatic;
     /// Expert: a packet continues while at least this many lanes enter a subtree; 0 keeps the
-    /// measured default (OctreeTracer::kDefaultMinPacketLanes). For the benchmark's A/B.
+    /// measured default (OctreeTracer::kDefaultMinPacketLanes, 2). At the root a packet starts
+    /// only with at least 4 lanes of the same direction signs (kMinStartLanes) or this many, if
+    /// more. For the benchmark's A/B.
     int packet_min_lanes = 0;
     /// Sort-last rendering (octiso-render --distribute data, octiso/bricks.h): only the cells of
     /// this box are tested, and nodes wholly outside it are never visited (nor their file pages

@@ -97,9 +97,14 @@ public:
     static constexpr int kMaxPacket = 8;
     /// A packet keeps traversing a subtree together while at least this many of its lanes enter
     /// it; fewer lanes continue as single rays. Measured by `octiso-bench packets` (BENCHMARKS.md,
-    /// packet section): primary rays are flat within 2 % from 1 to 4 lanes; at 2, incoherent rays
-    /// lost 5-10 % against single rays, at 4 they stay closest.
-    static constexpr int kDefaultMinPacketLanes = 4;
+    /// packet section): since the one-pass child cull, primary rays take 0.97-0.98 x the frame
+    /// time at 1 or 2 lanes against 4 (at 3: 0.98-0.99 x).
+    static constexpr int kDefaultMinPacketLanes = 2;
+    /// Lanes sharing their direction signs that start a packet at the root; fewer start as single
+    /// rays. Apart from the descent's threshold: a group of 2 or 3 random rays with the same signs
+    /// rarely shares a node, and incoherent rays through the packet entry lost 5-10 % against
+    /// single rays when 2 such lanes started a packet (BENCHMARKS.md, packet section).
+    static constexpr int kMinStartLanes = 4;
     /// For the benchmark's A/B of the threshold and for tests that force one path; not thread-safe
     /// against a frame in flight.
     void set_min_packet_lanes(int lanes) { min_packet_lanes_ = std::max(1, lanes); }
@@ -148,7 +153,7 @@ public:
         for (int flip = 0; flip < 8; ++flip) {
             const unsigned lanes = by_flip[flip];
             if (!lanes) continue;
-            if (std::popcount(lanes) < min_packet_lanes_) {
+            if (std::popcount(lanes) < std::max(kMinStartLanes, min_packet_lanes_)) {
                 for (unsigned m = lanes; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
                     node(p.lane[k], 0, 0, Coord{}, p.t0[k], p.t1[k]);
