@@ -23,11 +23,14 @@ OCTISO_ISA_BEGIN
 /// A coordinate that rounding left a hair off a cell face is put exactly on it, so that two
 /// cells sharing that face evaluate bitwise the same value there (cell.h) and the half-open
 /// rule reports a root on the face exactly once.
+/// Written as selects, not early returns: one coordinate of every entry and exit point lies on a
+/// face, which axis varies from cell to cell, and the branches it took were mispredicted:
+/// 0.970-0.983 x the frame time (min of 7 pairs, medians 0.971-0.999; build_ab_snap_selects.json).
 inline double snap_to_face(double p) {
     constexpr double kEps = 1e-12;
-    if (std::fabs(p) < kEps) return 0.0;
-    if (std::fabs(p - 1.0) < kEps) return 1.0;
-    return p;
+    double snapped = std::fabs(p - 1.0) < kEps ? 1.0 : p;
+    snapped = std::fabs(p) < kEps ? 0.0 : snapped;
+    return snapped;
 }
 
 /// What every cell-walking tracer fixes once per render: the isovalues, the placement, and the
