@@ -17,7 +17,9 @@
 #include <cstring>
 #include <type_traits>
 
-#include <smmintrin.h>   // SSE4.1 (x86-64-v2, the portable baseline): _mm_max_epu8, _mm_min_epu8
+#if defined(__SSE2__)
+#include <emmintrin.h>   // SSE2 (in every x86-64 build): _mm_max_epu8, _mm_min_epu8, _mm_movemask_epi8
+#endif
 
 #include "octiso/limits.h"
 #include "octiso/octree.h"
@@ -40,8 +42,11 @@ public:
                 // lo < 0 only where iso < lowest <= every min, hi > 255 only where iso > highest >=
                 // every max: no child holds such an isovalue.
                 if (!(lo >= 0 && hi <= 255)) continue;
-                floor_key_[used_] = _mm_set1_epi8(char(uint8_t(lo)));
-                ceil_key_[used_] = _mm_set1_epi8(char(uint8_t(hi)));
+                floor_key_[used_] = uint8_t(lo), ceil_key_[used_] = uint8_t(hi);
+#if defined(__SSE2__)
+                floor_splat_[used_] = _mm_set1_epi8(char(uint8_t(lo)));
+                ceil_splat_[used_] = _mm_set1_epi8(char(uint8_t(hi)));
+#endif
                 ++used_;
             }
         }
@@ -52,7 +57,9 @@ public:
         if constexpr (!kExact) {
             return 0xFFu;
         } else {
-            const __m128i flip = _mm_set1_epi8(std::is_signed_v<T> ? char(0x80) : char(0));
+            constexpr uint8_t kSign = std::is_signed_v<T> ? 0x80 : 0;
+#if defined(__SSE2__)
+            const __m128i flip = _mm_set1_epi8(char(kSign));
             uint64_t lo_bytes, hi_bytes;
             std::memcpy(&lo_bytes, n.bounds.min, 8);
             std::memcpy(&hi_bytes, n.bounds.max, 8);
@@ -61,17 +68,31 @@ public:
             __m128i any = _mm_setzero_si128();
             for (int i = 0; i < used_; ++i) {
                 // lo <= a  <=>  max(lo, a) == a;  hi >= b  <=>  min(hi, b) == b.
-                const __m128i below = _mm_cmpeq_epi8(_mm_max_epu8(lo, floor_key_[i]), floor_key_[i]);
-                const __m128i above = _mm_cmpeq_epi8(_mm_min_epu8(hi, ceil_key_[i]), ceil_key_[i]);
+                const __m128i a = floor_splat_[i], b = ceil_splat_[i];
+                const __m128i below = _mm_cmpeq_epi8(_mm_max_epu8(lo, a), a);
+                const __m128i above = _mm_cmpeq_epi8(_mm_min_epu8(hi, b), b);
                 any = _mm_or_si128(any, _mm_and_si128(below, above));
             }
             return unsigned(_mm_movemask_epi8(any)) & 0xFFu;
+#else
+            unsigned live = 0;
+            for (int c = 0; c < 8; ++c) {
+                const uint8_t lo = uint8_t(n.bounds.min[c]) ^ kSign, hi = uint8_t(n.bounds.max[c]) ^ kSign;
+                for (int i = 0; i < used_; ++i)
+                    live |= unsigned(lo <= floor_key_[i] && hi >= ceil_key_[i]) << c;
+            }
+            return live;
+#endif
         }
     }
 
 private:
-    __m128i floor_key_[kMaxIsovalues];
-    __m128i ceil_key_[kMaxIsovalues];
+    uint8_t floor_key_[kMaxIsovalues] = {};   ///< floor(iso) as a key, per isovalue inside the type's range
+    uint8_t ceil_key_[kMaxIsovalues] = {};    ///< ceil(iso) likewise
+#if defined(__SSE2__)
+    __m128i floor_splat_[kMaxIsovalues];   ///< the keys in all 16 bytes, made once
+    __m128i ceil_splat_[kMaxIsovalues];
+#endif
     int used_ = 0;
 };
 

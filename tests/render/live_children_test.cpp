@@ -4,6 +4,7 @@
 // the type's range, several at once); wider types hand every child to the per-child test.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <vector>
 
