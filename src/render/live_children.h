@@ -1,6 +1,6 @@
 // LiveChildren<T>: which children of an interior node may hold an isosurface, for all 8 at once.
 // For 1-byte scalars, whose child bounds are stored exact (ChildBounds<T, true>), the isovalues
-// become integer thresholds once per tracer and the cull of a node is a few SSE byte compares:
+// become integer thresholds once per tracer and the cull of a node is a few SSE2 byte compares:
 // an integer bound lo satisfies lo <= iso exactly when lo <= floor(iso), and hi >= iso exactly
 // when hi >= ceil(iso), so the mask is InteriorNode::may_contain_any's answer bit for bit. An
 // empty child (min > max) can satisfy neither pair, so it is never live.
@@ -8,8 +8,9 @@
 // live children are visited: 0.958-0.984 x the frame time (min of 7 interleaved pairs, medians
 // 0.957-0.977; build_ab_live_children.json, BENCHMARKS.md packet section). The same mask from a
 // plain loop over the 8 children in doubles was slower than the per-child test (1.03-1.06 x at
-// the median, same run set-up, no JSON), so wider scalars, whose quantized bounds decode through
-// a multiply each, keep the per-child test (may_contain_any) in the traversal.
+// the median; build_ab_live_children_double_loop_rerun.json), so wider scalars, whose quantized
+// bounds decode through a multiply each, keep the per-child test (may_contain_any): holds() is
+// the one predicate the traversal asks, whichever it is.
 #pragma once
 
 #include <cmath>
@@ -42,10 +43,11 @@ public:
                 // lo < 0 only where iso < lowest <= every min, hi > 255 only where iso > highest >=
                 // every max: no child holds such an isovalue.
                 if (!(lo >= 0 && hi <= 255)) continue;
-                floor_key_[used_] = uint8_t(lo), ceil_key_[used_] = uint8_t(hi);
 #if defined(__SSE2__)
-                floor_splat_[used_] = _mm_set1_epi8(char(uint8_t(lo)));
-                ceil_splat_[used_] = _mm_set1_epi8(char(uint8_t(hi)));
+                floor_key_[used_] = _mm_set1_epi8(char(uint8_t(lo)));
+                ceil_key_[used_] = _mm_set1_epi8(char(uint8_t(hi)));
+#else
+                floor_key_[used_] = uint8_t(lo), ceil_key_[used_] = uint8_t(hi);
 #endif
                 ++used_;
             }
@@ -68,7 +70,7 @@ public:
             __m128i any = _mm_setzero_si128();
             for (int i = 0; i < used_; ++i) {
                 // lo <= a  <=>  max(lo, a) == a;  hi >= b  <=>  min(hi, b) == b.
-                const __m128i a = floor_splat_[i], b = ceil_splat_[i];
+                const __m128i a = floor_key_[i], b = ceil_key_[i];
                 const __m128i below = _mm_cmpeq_epi8(_mm_max_epu8(lo, a), a);
                 const __m128i above = _mm_cmpeq_epi8(_mm_min_epu8(hi, b), b);
                 any = _mm_or_si128(any, _mm_and_si128(below, above));
@@ -86,12 +88,23 @@ public:
         }
     }
 
+    /// Whether child c of `n` may hold an isosurface, given live = of(n): the mask where it is
+    /// exact, else the per-child test. The one cull predicate of the traversal.
+    OCTISO_ALWAYS_INLINE static bool holds(const InteriorNode<T>& n, unsigned live, int c, const double* isos,
+                                           int count) {
+        if constexpr (kExact) return (live >> c) & 1u;
+        else return n.may_contain_any(c, isos, count);
+    }
+
 private:
-    uint8_t floor_key_[kMaxIsovalues] = {};   ///< floor(iso) as a key, per isovalue inside the type's range
-    uint8_t ceil_key_[kMaxIsovalues] = {};    ///< ceil(iso) likewise
+    // floor(iso) and ceil(iso) as keys, one per isovalue inside the type's range: in all 16 bytes
+    // of a register where SSE2 compares them, else as bytes.
 #if defined(__SSE2__)
-    __m128i floor_splat_[kMaxIsovalues];   ///< the keys in all 16 bytes, made once
-    __m128i ceil_splat_[kMaxIsovalues];
+    __m128i floor_key_[kMaxIsovalues];
+    __m128i ceil_key_[kMaxIsovalues];
+#else
+    uint8_t floor_key_[kMaxIsovalues] = {};
+    uint8_t ceil_key_[kMaxIsovalues] = {};
 #endif
     int used_ = 0;
 };

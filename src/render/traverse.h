@@ -98,7 +98,8 @@ public:
     /// A packet keeps traversing a subtree together while at least this many of its lanes enter
     /// it; fewer lanes continue as single rays. Measured by `octiso-bench packets` (BENCHMARKS.md,
     /// packet section): since the one-pass child cull, primary rays take 0.97-0.98 x the frame
-    /// time at 1 or 2 lanes against 4 (at 3: 0.98-0.99 x).
+    /// time at 1 or 2 lanes against 4, at 3 0.98-0.99 x (packets_session4_threshold.json; at 2
+    /// against 4 as an A/B of builds: build_ab_packet_threshold_2.json).
     static constexpr int kDefaultMinPacketLanes = 2;
     /// Lanes sharing their direction signs that start a packet at the root; fewer start as single
     /// rays. Apart from the descent's threshold: a group of 2 or 3 random rays with the same signs
@@ -226,8 +227,7 @@ private:
         CapParent parent(n, first);   // used only at depth dmax-2
         bool hit = false;
         for_each_child_piece(w.ray, o, half, t0, t1, [&](int c, double t_cur, double t_next) {
-            const bool culled = !((live >> c) & 1u) || (!LiveChildren<T>::kExact &&
-                                                        !n.may_contain_any(c, scene_.isovalues, scene_.iso_count));
+            const bool culled = !LiveChildren<T>::holds(n, live, c, scene_.isovalues, scene_.iso_count);
             if constexpr (Recorder::kOn)
                 if (culled)
                     recorder_.cull(d, c, child_origin_of(o, c, half), half, n.bounds.lower(c), n.bounds.upper(c),
@@ -450,7 +450,7 @@ private:
         CapParent parent(n, first);   // used only at depth dmax-2
         for (unsigned m = in_visit_order(live, flip); m && active; m &= m - 1) {
             const unsigned c = unsigned(std::countr_zero(m) ^ flip);
-            if (!LiveChildren<T>::kExact && !n.may_contain_any(int(c), scene_.isovalues, scene_.iso_count)) continue;
+            if (!LiveChildren<T>::holds(n, live, int(c), scene_.isovalues, scene_.iso_count)) continue;
             const unsigned entered = split.enter(c, active);
             if (!entered) continue;
             const double* c0 = split.lo(c);
