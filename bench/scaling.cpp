@@ -1,4 +1,4 @@
-// octiso-bench scaling (issue 5, item 3; the paper's Fig. 9): frames/s of render() (Embree, shading)
+// octiso-bench scaling (issue 5, item 3; the paper's Fig. 9): frames/s of render() (default path: packets, shading)
 // on 1..nproc threads at 512^2 and 1024^2, and the load-balance bound of the dynamic tile scheduler
 // on 1..64 workers: 8x8 blocks timed single-threaded, summed into tiles, list-scheduled in TBB's
 // split order (each worker takes the next tile when free: work stealing without overhead); speedup
@@ -428,7 +428,7 @@ int run_scaling(cli::Args& args) {
                 fmt(Measured::median_of(m.call_seconds) - m.median(), 4), fmt(100.0 * model_eff, 1) + " %",
                 fmt(100.0 * (call_speedup / m.threads - model_eff), 1) + " pt"});
     }
-    std::cout << "measured (render(), Embree path, colour, median of " << repeats << " interleaved repeats); "
+    std::cout << "measured (render(), default path: direct packet traversal, colour, median of " << repeats << " interleaved repeats); "
                  "efficiency = tile-loop speedup / P; utilisation = thread seconds inside tiles / (P x tile-loop "
                  "wall); busy / busy(1) > 1 is each tile costing more on P threads (shared caches, memory), not "
                  "scheduling; CPU-work eff. = process CPU of 1 thread / process CPU of P threads; model eff. = the "
