@@ -74,7 +74,7 @@ template <typename T> uint64_t brick_bytes(const Octree<T>& t, const CellBox& b)
         for (int c = 0; c < 8; ++c) {
             const Coord co{o.x + ((c & 4) ? half : 0), o.y + ((c & 2) ? half : 0), o.z + ((c & 1) ? half : 0)};
             if (n.is_scalar_leaf(c) || !meets(co, half)) continue;
-            if (d + 1 == t.dmax() - 1) bytes += n.cap_bits;   // a packed cap (octree.h)
+            if (d + 1 == t.dmax() - 1) bytes += n.cap_record_bytes();   // a packed cap (octree.h)
             else self(self, d + 1, t.child_index(d, index, n, c), co);
         }
     };

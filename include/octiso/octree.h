@@ -15,14 +15,17 @@
 //    no larger;
 //  - a node's first child is a 64-bit base per group of 128 nodes plus a 16-bit offset
 //    (format 5), not a 48-bit number per node;
-//  - a cap is stored as 8 deltas of `cap_bits` bits from a base held in its parent's scalar slot
-//    (the base is the cap's smallest voxel, in the order of ScalarKey), all caps of one parent
-//    with the same width, so that a cap of b bits takes b bytes and is found by a multiply;
-//    where that saves nothing the cap is stored whole.
+//  - a cap is stored as 8 deltas of b bits, all caps of one parent with the same width, so that
+//    a cap is found by a multiply. Wider scalars: from a base held in its parent's scalar slot
+//    (the cap's smallest voxel, in the order of ScalarKey), b bytes a cap, or the cap stored whole
+//    where that saves nothing. 1-byte scalars (format 6): from the child's lower or upper bound,
+//    which the parent holds anyway, so that the slot carries the first of the b bytes and the cap
+//    level b - 1 (CapAnchor below).
 #pragma once
 
 #include <array>
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -62,6 +65,31 @@ template <typename T> inline constexpr unsigned kWholeCapBits = 8 * sizeof(T);
 /// The widest delta a packed (not whole) cap may have: base + deltas must be smaller than the
 /// whole cap, and every delta must come out of one unaligned 64-bit load (shift <= 7).
 template <typename T> inline constexpr unsigned kMaxDeltaBits = 8 * sizeof(T) - 1 < 56 ? 8 * sizeof(T) - 1 : 56;
+/// 1-byte scalars (format 6): where a cap parent's caps take their base from, bit 7 of
+/// cap_bits (the width b, 1 .. 8, below it). The 8 deltas of a cap form one 64-bit word whose
+/// byte 0 is the parent's scalar[c] and bytes 1 .. b-1 the cap's record, b - 1 bytes in the cap
+/// level; in the scalars' keys (ScalarKey), mod 256:
+///   lower: voxel k = bounds.min[c] + delta k;
+///   upper: voxel k = bounds.max[c] - (2^b - 1) + delta k (the deltas count up to the bound, so
+///          that both anchors decode by one add).
+/// The bounds cover the cap's cells, so the base costs no byte: one byte a cap less than a base
+/// in the slot where the width stays, more where the data sit near one end of their range, and
+/// the packer takes the end that gives the narrower width per parent (plume 256^3 32.7 -> 29.5 %
+/// of raw, mixing 25.4 -> 23.3 %, ch2better 40.0 -> 35.9 %; BENCHMARKS.md "The compact octree,
+/// format 6"). Where a cap holds voxels its bounds do not (the last data layer, which no cell of
+/// the cap starts at), the packer widens the bounds, which only culls less; a cap child with no
+/// cells keeps empty bounds (min > max) chosen so that its deltas still fit.
+/// A cap lookup reads the bound by index and subtracts, a voxel is a shift, a mask and an add:
+/// no branch on the per-parent choice, which would be mispredicted (a first trial with a third,
+/// slot, anchor and branches or selects on it cost 3.5-6.7 % of the frame).
+enum class CapAnchor : uint8_t { lower = 0, upper = 1 };
+inline constexpr unsigned kCapAnchorShift = 7;
+inline constexpr uint8_t kCapWidthMask = (1u << kCapAnchorShift) - 1u;
+/// cap_bits of a 1-byte parent: width b in the low bits, the anchor above.
+inline constexpr uint8_t cap_bits_of(unsigned width, CapAnchor anchor) {
+    return uint8_t(width | (unsigned(anchor) << kCapAnchorShift));
+}
+
 /// The cap level of one step holds at most this many bytes (2^48, 256 TiB; interior levels keep
 /// 32-bit node indices, which the traversal's parent traces hold).
 inline constexpr uint64_t kMaxCapByteOffset = uint64_t(1) << 48;
@@ -146,26 +174,39 @@ template <> struct RecordTail<double> { uint32_t zero = 0; };
 ///                           the group base plus child_offset; rank: stored children before c)
 ///                           and scalar[c] is the voxel at its lower corner (the level-of-detail
 ///                           lattice sample, see lattice_value). At depth dmax-2 it is a cap: its
-///                           record starts at byte first + rank(c) * cap_bits of the caps (8
-///                           deltas of b bits are b bytes), and scalar[c] is its base.
+///                           record starts at byte first + rank(c) * cap_record_bytes() of the
+///                           caps (8 deltas of b bits are b bytes), and scalar[c] is its base,
+///                           or (1-byte scalars, CapAnchor) the first of the b bytes.
 ///   bounds: ChildBounds above.
 /// Every node's first child is where the previous node's children end (the first node's is 0),
 /// childless nodes included, so the whole index is the prefix sum of children_span(); the loader
-/// validates exactly that, and that cap_bits is kWholeCapBits or at most kMaxDeltaBits.
+/// validates exactly that, and that cap_bits holds a width of kWholeCapBits or at most
+/// kMaxDeltaBits (1-byte scalars: 1 .. 8, and the anchor bit; 0 where no child is stored).
 template <typename T> struct InteriorNode {
     T scalar[8];
     ChildBounds<T> bounds;
     uint16_t child_offset;     ///< first child, relative to the group's base
     uint8_t child_mask;
-    uint8_t cap_bits;          ///< depth dmax-2: bits per cap voxel; zero above
+    uint8_t cap_bits;          ///< depth dmax-2: bits per cap voxel (1-byte scalars: and CapAnchor); zero above
     [[no_unique_address]] RecordTail<T> tail;
 
     OCTISO_ALWAYS_INLINE bool is_scalar_leaf(int c) const { return ((child_mask >> c) & 1u) == 0; }
     OCTISO_ALWAYS_INLINE uint32_t rank(int c) const { return uint32_t(std::popcount(unsigned(child_mask) & ((1u << c) - 1u))); }
+    /// A cap parent's width b (bits per delta) and, 1-byte scalars only, anchor (CapAnchor).
+    OCTISO_ALWAYS_INLINE unsigned cap_width() const {
+        if constexpr (sizeof(T) == 1) return cap_bits & kCapWidthMask;
+        else return cap_bits;
+    }
+    /// Bytes of one cap in the caps: b, or (1-byte scalars) b - 1, its first byte in the slot (0
+    /// where b = 0, which the loader accepts only in a cap parent with no stored child).
+    OCTISO_ALWAYS_INLINE unsigned cap_record_bytes() const {
+        if constexpr (sizeof(T) == 1) return cap_width() - (cap_width() != 0);
+        else return cap_bits;
+    }
     /// What the stored children take in the level below: nodes, or (`caps_below`, a cap parent)
     /// bytes of caps. The builders and the validator place and check children by it.
     uint64_t children_span(bool caps_below) const {
-        return uint64_t(std::popcount(unsigned(child_mask))) * (caps_below ? cap_bits : 1u);
+        return uint64_t(std::popcount(unsigned(child_mask))) * (caps_below ? cap_record_bytes() : 1u);
     }
     OCTISO_ALWAYS_INLINE bool may_contain_any(int c, const double* isos, int count) const {
         if (bounds.empty(c)) return false;
@@ -220,6 +261,24 @@ template <typename T> struct CapRef {
             std::memcpy(out, record, 8 * sizeof(T));
             return;
         }
+        for (int k = 0; k < 8; ++k) out[k] = voxel(k);
+    }
+};
+
+/// 1-byte scalars: the cap's 8 deltas of b <= 8 bits as one 64-bit word (CapAnchor), read when
+/// the cap is found, so that a voxel is a shift, a mask and an add in the key's 8 bits.
+template <typename T>
+    requires(sizeof(T) == 1)
+struct CapRef<T> {
+    uint64_t word = 0;
+    unsigned bits = 0;
+    uint8_t base = 0;   ///< ScalarKey of the lowest value the deltas reach (CapAnchor)
+
+    OCTISO_ALWAYS_INLINE T voxel(int k) const {
+        const unsigned delta = unsigned(word >> (unsigned(k) * bits)) & ((1u << bits) - 1u);
+        return ScalarKey<T>::value(uint8_t(base + delta));
+    }
+    OCTISO_ALWAYS_INLINE void decode(T out[8]) const {
         for (int k = 0; k < 8; ++k) out[k] = voxel(k);
     }
 };
@@ -287,7 +346,24 @@ public:
         return uint32_t(first + n.rank(c));
     }
     OCTISO_ALWAYS_INLINE CapRef<T> cap_at(uint64_t first, const InteriorNode<T>& parent, int c) const {
-        return {a_.caps + first + uint64_t(parent.rank(c)) * parent.cap_bits, parent.cap_bits, parent.scalar[c]};
+        if constexpr (sizeof(T) == 1) {
+            using K = ScalarKey<T>;
+            const unsigned bits = parent.cap_width(), upper = unsigned(parent.cap_bits) >> kCapAnchorShift;
+            uint64_t word;   // in bounds: kCapReadSlack
+            std::memcpy(&word, a_.caps + first + uint64_t(parent.rank(c)) * (bits - 1u), 8);
+            CapRef<T> r;
+            r.word = (word << 8) | K::of(parent.scalar[c]);
+            r.bits = bits;
+            // The bounds' bytes are min[8] then max[8]: the anchor's bound by index, without a
+            // branch or a select; an upper anchor's deltas count up from max[c] - (2^b - 1).
+            static_assert(sizeof(parent.bounds) == 16 && offsetof(ChildBounds<T>, max) == 8);
+            const auto* bound_bytes = reinterpret_cast<const unsigned char*>(&parent.bounds);
+            const unsigned bound = K::of(std::bit_cast<T>(bound_bytes[unsigned(c) + 8 * upper]));
+            r.base = uint8_t(bound - (((1u << bits) - 1u) & (0u - upper)));
+            return r;
+        } else {
+            return {a_.caps + first + uint64_t(parent.rank(c)) * parent.cap_bits, parent.cap_bits, parent.scalar[c]};
+        }
     }
     /// Index at depth d+1 of stored child c of `n`, node i at depth d < dmax-2.
     OCTISO_ALWAYS_INLINE uint32_t child_index(int d, uint64_t i, const InteriorNode<T>& n, int c) const {

@@ -190,6 +190,9 @@ void OctFile::Impl::check_header() {
     if (h.version == 4)
         fail("is .oct format version 4, the node layout before child groups (format 5): convert "
              "the source again with octiso-convert");
+    if (h.version == 5)
+        fail("is .oct format version 5, the cap layout before bound-anchored caps (format 6): convert "
+             "the source again with octiso-convert");
     if (h.version != format::kFormatVersion)
         fail("unsupported format version (expected " + num(format::kFormatVersion) + ", found " + num(h.version) + ")");
     if (h.header_bytes != sizeof(FileHeader))

@@ -60,9 +60,14 @@
 //    28 bytes for 1-byte scalars, 40 for 2, 60 for 4, 104 for 8 (format 4: 32, 44, 64, 104; format 2:
 //    24 s + 8).
 //  Caps section: a byte array (record_bytes 1, count = its bytes). The caps of one depth dmax-2
-//  parent follow each other from its first child (a byte offset), each cap_bits bytes: 8 deltas of
-//  cap_bits bits, little-endian bit order, voxel k at bits [k b, (k+1) b) of the record, added to
-//  the key (ScalarKey) of the parent's scalar[c]; cap_bits == 8 s: the 8 voxels stored whole.
+//  parent follow each other from its first child (a byte offset). Each is 8 deltas of b bits,
+//  little-endian bit order, delta k at bits [k b, (k+1) b) of a little-endian word:
+//    s > 1:  b = cap_bits; the word is the cap's b bytes; voxel k = key (ScalarKey) of the
+//            parent's scalar[c] + delta k; b == 8 s: the 8 voxels stored whole;
+//    s == 1: b = cap_bits & 0x7f (1 .. 8), anchor a = cap_bits >> 7 (format 6, CapAnchor in
+//            octree.h); the word's byte 0 is the parent's scalar[c], bytes 1 .. b-1 the cap's
+//            b - 1 bytes; voxel k = min[c] + delta k (a = 0) or max[c] - (2^b - 1) + delta k
+//            (a = 1), keys mod 256.
 //  The section ends with kCapReadSlack zero bytes (every delta is one 8-byte load). Octant
 //  c = x<<2 | y<<1 | z.
 // ---------------------------------------------------------------------------------------------
@@ -82,7 +87,10 @@ inline constexpr char kMagic[8] = {'O', 'C', 'T', 'I', 'S', 'O', '\0', '\x1a'};
 /// version 3 files are refused with a message to convert again (`--lod` would misread them).
 /// 5: first children as group bases plus 16-bit offsets, the scalars first in the record (issue
 /// 19); version 4 files are refused with a message to convert again.
-inline constexpr uint32_t kFormatVersion = 5;
+/// 6: 1-byte caps take their base from the child's lower or upper bound, their first byte in the
+/// parent's scalar slot (CapAnchor, issue 19); version 5 files are refused with a message to
+/// convert again.
+inline constexpr uint32_t kFormatVersion = 6;
 inline constexpr uint32_t kEndianTag = 0x01020304u;   ///< reads back as 0x04030201 if swapped
 inline constexpr uint64_t kSectionAlign = 64;
 

@@ -64,14 +64,23 @@ std::string where(uint32_t step, int depth, int dmax) {
            (depth == dmax - 1 ? " (caps)" : " (interior nodes)");
 }
 
-// The node's own fields (format 5, octree.h): the cap width where caps lie below and zero width
+// The node's own fields (format 6, octree.h): the cap width and anchor where caps lie below and zero width
 // elsewhere, a zero tail, ordered finite bounds (wider scalars), lattice samples inside their ranges; then its
 // children inside the level below. Allocation-free: the touch validator runs it in a fault
 // handler (touch_validation.h); node_problem() words the same checks for a message.
+// A width of kWholeCapBits or at most kMaxDeltaBits; 1-byte scalars (format 6, CapAnchor): a
+// width of 1 .. 8 below the anchor bit, either anchor (the slot keeps the first of the b bytes),
+// or 0 in a cap parent with no stored child (all its children scalar leaves, never packed).
+template <typename T> bool cap_bits_valid(const InteriorNode<T>& n) noexcept {
+    const unsigned width = n.cap_width();
+    if constexpr (sizeof(T) == 1) return width <= 8 && (width >= 1 || n.child_mask == 0);
+    else return width == kWholeCapBits<T> || width <= kMaxDeltaBits<T>;
+}
+
 template <typename T>
 NodeDefect node_defect(const InteriorNode<T>& n, uint64_t group_base, bool caps_below, uint64_t next_count) noexcept {
     if (caps_below) {
-        if (n.cap_bits != kWholeCapBits<T> && n.cap_bits > kMaxDeltaBits<T>) return NodeDefect::cap_bits;
+        if (!cap_bits_valid(n)) return NodeDefect::cap_bits;
     } else if (n.cap_bits != 0) {
         return NodeDefect::high_fields;
     }
@@ -104,6 +113,9 @@ std::string node_problem(const InteriorNode<T>& n, uint64_t group_base, bool cap
     switch (node_defect(n, group_base, caps_below, next_count)) {
     case NodeDefect::none: return {};
     case NodeDefect::cap_bits:
+        if constexpr (sizeof(T) == 1)
+            return "cap_bits out of range (expected a width of 1 .. 8 in bits 0-6 and the anchor in bit 7, or 0 without "
+                   "stored children; found " + std::to_string(n.cap_bits) + " with child_mask " + std::to_string(n.child_mask) + ")";
         return "cap_bits out of range (expected 0 .. " + std::to_string(kMaxDeltaBits<T>) + " or " +
                std::to_string(kWholeCapBits<T>) + ", found " + std::to_string(n.cap_bits) + ")";
     case NodeDefect::high_fields:

@@ -272,6 +272,40 @@ TEST(OctReject, CompactNodeFieldsAreValidated) {
 
 /// Format 5 (issue 19): the zero bytes between an interior level's records and its group bases
 /// (u8 records are 28 bytes, so a level of one node has 4), and the zero tail of a double record.
+/// Format 6's 1-byte cap field (CapAnchor, octree.h): a width of 1 .. 8 below the anchor bit, 0
+/// only in a cap parent without stored children. Each refusal names the field and the value.
+TEST(OctReject, OneByteCapWidthsAreValidated) {
+    ScratchDir dir;
+    const std::string good = dir.file("good.oct"), bad = dir.file("bad.oct");
+    const auto v = make_volume<uint8_t>({9, 6, 5}, Pattern::Random, 5);
+    write_oct<uint8_t>(good, info_for(ScalarType::u8, v.dims), {build_octree(v.view(), {}).view()});
+    const int dmax = OctBytes(good).header().dmax;
+    ASSERT_NE(OctBytes(good).node<uint8_t>(0, dmax - 2, 0).child_mask, 0) << "fixture needs a cap parent with caps";
+    auto expect = [&](uint8_t cap_bits, const std::string& words) {
+        OctBytes b(good);
+        auto n = b.node<uint8_t>(0, dmax - 2, 0);
+        n.cap_bits = cap_bits;
+        b.set_node(0, dmax - 2, 0, n);
+        b.rechecksum();
+        b.save(bad);
+        for (Verify verify : {Verify::Full, Verify::IndicesOnly}) {
+            try {
+                load_everything(bad, verify);
+                ADD_FAILURE() << words << ": accepted";
+            } catch (const Error& e) {
+                EXPECT_EQ(e.subject(), bad);
+                EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+            }
+        }
+    };
+    const auto stored = std::to_string(OctBytes(good).node<uint8_t>(0, dmax - 2, 0).child_mask);
+    expect(9, "cap_bits out of range (expected a width of 1 .. 8 in bits 0-6 and the anchor in bit 7, or 0 without "
+              "stored children; found 9 with child_mask " + stored + ")");
+    expect(0x80 | 9, "found 137 with child_mask " + stored);
+    expect(0, "found 0 with child_mask " + stored);   // no width, yet caps to read
+    expect(0x80, "found 128 with child_mask " + stored);
+}
+
 TEST(OctReject, GroupPaddingAndRecordTailMustBeZero) {
     {
         Fixture fx;
@@ -552,6 +586,12 @@ TEST(OctReject, VersionThreeFilesAskToBeConvertedAgain) {
 TEST(OctReject, VersionFourFilesAskToBeConvertedAgain) {
     // Version 4 kept a 48-bit first child in every node: its records are not format 5's (issue 19).
     expect_version_refused(4);
+}
+
+TEST(OctReject, VersionFiveFilesAskToBeConvertedAgain) {
+    // Version 5's 1-byte caps kept their base in the slot: format 6 reads the slot as the first
+    // byte of the deltas and takes the base from a bound (issue 19), so it would decode wrong voxels.
+    expect_version_refused(5);
 }
 
 TEST(OctReject, NonFilesAndEmptyFilesAreErrors) {

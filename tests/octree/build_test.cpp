@@ -2,6 +2,7 @@
 // voxel, neighbour finding of every forward neighbour, exact min/max, tolerance, iso-range.
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "octiso/build.h"
 #include "octiso/error.h"
@@ -153,6 +154,54 @@ TYPED_TEST(OctreeBuild, ToleranceNeverExceedsEpsAndRangesStillBoundStoredCells) 
             }
         });
     }
+}
+
+/// Format 6 (CapAnchor, octree.h): a 1-byte cap takes its base from its child's lower or upper
+/// bound, per parent the narrower. Dark data with a little noise takes the lower, bright data
+/// the upper, and every voxel comes back, odd extents (border caps whose last layer no cell
+/// starts at, whose bounds the packer widens or chooses) included.
+template <typename T> void expect_both_anchors_exact() {
+    const Dims dims{37, 21, 19};
+    DenseVolume<T> v{dims, std::vector<T>(dims.voxels())};
+    uint32_t state = 12345;
+    const auto noise = [&] { return (state = state * 1664525u + 1013904223u) >> 29; };   // 0 .. 7
+    for (uint32_t z = 0; z < dims.z; ++z)
+        for (uint32_t y = 0; y < dims.y; ++y)
+            for (uint32_t x = 0; x < dims.x; ++x) {
+                const int lowest = int(std::numeric_limits<T>::lowest()), highest = int(std::numeric_limits<T>::max());
+                // x < 18: near the lowest value; above: near the highest; one bright line in the dark.
+                const int value = x < 18 && y != 7 ? lowest + int(noise()) + (x % 3) : highest - int(noise()) - (z % 3);
+                v.values[uint64_t(z) * dims.y * dims.x + uint64_t(y) * dims.x + x] = T(value);
+            }
+    const auto built = build_octree(v.view(), {});
+    const Octree<T> tree = built.view();
+    expect_every_voxel_located(v, tree);
+    uint64_t anchors[2] = {};
+    const int d = tree.dmax() - 2;
+    for (uint64_t i = 0; i < tree.node_count(d); ++i) {
+        const InteriorNode<T>& n = tree.node(d, i);
+        if (n.child_mask == 0) continue;
+        ++anchors[n.cap_bits >> kCapAnchorShift];
+        EXPECT_GE(n.cap_width(), 1u);
+        EXPECT_LE(n.cap_width(), 8u);
+        // The base is a bound of each cap child, and the bounds still cover its cells.
+        for (int c = 0; c < 8; ++c)
+            if (!n.is_scalar_leaf(c)) {
+                T voxel[8];
+                tree.cap(i, n, c).decode(voxel);
+                for (T x : voxel)
+                    if (n.bounds.empty(c)) continue;
+                    else if (n.cap_bits >> kCapAnchorShift) EXPECT_LE(x, n.bounds.max[c]);
+                    else EXPECT_GE(x, n.bounds.min[c]);
+            }
+    }
+    EXPECT_GT(anchors[0], 0u) << "no parent took the lower bound";
+    EXPECT_GT(anchors[1], 0u) << "no parent took the upper bound";
+}
+
+TEST(OctreeBuildOneByte, CapsTakeEitherBoundAndComeBackExactly) {
+    expect_both_anchors_exact<uint8_t>();
+    expect_both_anchors_exact<int8_t>();
 }
 
 TYPED_TEST(OctreeBuild, IsoRangeKeepsEveryCellThatReachesIntoTheRange) {
