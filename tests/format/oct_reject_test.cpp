@@ -210,6 +210,25 @@ TEST(OctReject, ChildIndicesOutOfRangeOrOverlappingAreErrors) {
     }
 }
 
+/// `good` edited by `edit` and checksummed again, saved as `bad`: every load of it, with full and
+/// with index-only verification, must fail naming `bad` and saying `words`.
+void expect_edit_refused(const std::string& good, const std::string& bad, const std::function<void(OctBytes&)>& edit,
+                         const std::string& words) {
+    OctBytes b(good);
+    edit(b);
+    b.rechecksum();
+    b.save(bad);
+    for (Verify verify : {Verify::Full, Verify::IndicesOnly}) {
+        try {
+            load_everything(bad, verify);
+            ADD_FAILURE() << words << ": accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.subject(), bad);
+            EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+        }
+    }
+}
+
 /// Format 3's own fields (issue 19), on a u16 file (quantized bounds, caps up to 16 bits):
 /// each check names what it found.
 TEST(OctReject, CompactNodeFieldsAreValidated) {
@@ -219,19 +238,7 @@ TEST(OctReject, CompactNodeFieldsAreValidated) {
     write_oct<uint16_t>(good, info_for(ScalarType::u16, v.dims), {build_octree(v.view(), {}).view()});
     const int dmax = OctBytes(good).header().dmax;
     auto expect = [&](const std::function<void(OctBytes&)>& edit, const std::string& words) {
-        OctBytes b(good);
-        edit(b);
-        b.rechecksum();
-        b.save(bad);
-        for (Verify verify : {Verify::Full, Verify::IndicesOnly}) {
-            try {
-                load_everything(bad, verify);
-                ADD_FAILURE() << words << ": accepted";
-            } catch (const Error& e) {
-                EXPECT_EQ(e.subject(), bad);
-                EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
-            }
-        }
+        expect_edit_refused(good, bad, edit, words);
     };
     expect([&](OctBytes& b) {
         auto n = b.node<uint16_t>(0, dmax - 2, 0);
@@ -282,21 +289,11 @@ TEST(OctReject, OneByteCapWidthsAreValidated) {
     const int dmax = OctBytes(good).header().dmax;
     ASSERT_NE(OctBytes(good).node<uint8_t>(0, dmax - 2, 0).child_mask, 0) << "fixture needs a cap parent with caps";
     auto expect = [&](uint8_t cap_bits, const std::string& words) {
-        OctBytes b(good);
-        auto n = b.node<uint8_t>(0, dmax - 2, 0);
-        n.cap_bits = cap_bits;
-        b.set_node(0, dmax - 2, 0, n);
-        b.rechecksum();
-        b.save(bad);
-        for (Verify verify : {Verify::Full, Verify::IndicesOnly}) {
-            try {
-                load_everything(bad, verify);
-                ADD_FAILURE() << words << ": accepted";
-            } catch (const Error& e) {
-                EXPECT_EQ(e.subject(), bad);
-                EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
-            }
-        }
+        expect_edit_refused(good, bad, [&](OctBytes& b) {
+            auto n = b.node<uint8_t>(0, dmax - 2, 0);
+            n.cap_bits = cap_bits;
+            b.set_node(0, dmax - 2, 0, n);
+        }, words);
     };
     const auto stored = std::to_string(OctBytes(good).node<uint8_t>(0, dmax - 2, 0).child_mask);
     expect(9, "cap_bits out of range (expected a width of 1 .. 8 in bits 0-6 and the anchor in bit 7, or 0 without "
