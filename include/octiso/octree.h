@@ -197,6 +197,12 @@ template <typename T> struct InteriorNode {
         if constexpr (sizeof(T) == 1) return cap_bits & kCapWidthMask;
         else return cap_bits;
     }
+    /// 1-byte scalars: the bound a cap parent's caps count from (CapAnchor).
+    OCTISO_ALWAYS_INLINE CapAnchor cap_anchor() const
+        requires(sizeof(T) == 1)
+    {
+        return CapAnchor(cap_bits >> kCapAnchorShift);
+    }
     /// Bytes of one cap in the caps: b, or (1-byte scalars) b - 1, its first byte in the slot (0
     /// where b = 0, which the loader accepts only in a cap parent with no stored child).
     OCTISO_ALWAYS_INLINE unsigned cap_record_bytes() const {
@@ -348,7 +354,8 @@ public:
     OCTISO_ALWAYS_INLINE CapRef<T> cap_at(uint64_t first, const InteriorNode<T>& parent, int c) const {
         if constexpr (sizeof(T) == 1) {
             using K = ScalarKey<T>;
-            const unsigned bits = parent.cap_width(), upper = unsigned(parent.cap_bits) >> kCapAnchorShift;
+            const unsigned bits = parent.cap_width(), upper = unsigned(parent.cap_anchor());
+            // bits - 1 is cap_record_bytes(): a parent with a cap has b >= 1 (the loader checks).
             uint64_t word;   // in bounds: kCapReadSlack
             std::memcpy(&word, a_.caps + first + uint64_t(parent.rank(c)) * (bits - 1u), 8);
             CapRef<T> r;

@@ -64,10 +64,6 @@ std::string where(uint32_t step, int depth, int dmax) {
            (depth == dmax - 1 ? " (caps)" : " (interior nodes)");
 }
 
-// The node's own fields (format 6, octree.h): the cap width and anchor where caps lie below and zero width
-// elsewhere, a zero tail, ordered finite bounds (wider scalars), lattice samples inside their ranges; then its
-// children inside the level below. Allocation-free: the touch validator runs it in a fault
-// handler (touch_validation.h); node_problem() words the same checks for a message.
 // A width of kWholeCapBits or at most kMaxDeltaBits; 1-byte scalars (format 6, CapAnchor): a
 // width of 1 .. 8 below the anchor bit, either anchor (the slot keeps the first of the b bytes),
 // or 0 in a cap parent with no stored child (all its children scalar leaves, never packed).
@@ -77,6 +73,10 @@ template <typename T> bool cap_bits_valid(const InteriorNode<T>& n) noexcept {
     else return width == kWholeCapBits<T> || width <= kMaxDeltaBits<T>;
 }
 
+// The node's own fields (format 6, octree.h): the cap width and anchor where caps lie below and zero width
+// elsewhere, a zero tail, ordered finite bounds (wider scalars), lattice samples inside their ranges; then its
+// children inside the level below. Allocation-free: the touch validator runs it in a fault
+// handler (touch_validation.h); node_problem() words the same checks for a message.
 template <typename T>
 NodeDefect node_defect(const InteriorNode<T>& n, uint64_t group_base, bool caps_below, uint64_t next_count) noexcept {
     if (caps_below) {

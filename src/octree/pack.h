@@ -64,27 +64,30 @@ template <typename T> uint64_t pack_anchored_caps(InteriorNode<T>& node, const C
     static_assert(sizeof(T) == 1);
     using K = ScalarKey<T>;
     int child[8];
+    uint8_t key[8][8];    // per cap, per voxel
     uint8_t base[2][8];   // per anchor, per cap: the key of its base
     unsigned width[2] = {1, 1};
     for (int c = 0, j = 0; c < 8; ++c) {
         if (node.is_scalar_leaf(c)) continue;
         child[j] = c;
         uint8_t lo = 255, hi = 0;
-        for (int k = 0; k < 8; ++k) lo = std::min(lo, uint8_t(K::of(caps[j].voxel[k]))), hi = std::max(hi, uint8_t(K::of(caps[j].voxel[k])));
+        for (int k = 0; k < 8; ++k) {
+            key[j][k] = K::of(caps[j].voxel[k]);
+            lo = std::min(lo, key[j][k]), hi = std::max(hi, key[j][k]);
+        }
         if (!node.bounds.empty(c)) {
-            base[0][j] = std::min(uint8_t(K::of(node.bounds.min[c])), lo);
-            base[1][j] = std::max(uint8_t(K::of(node.bounds.max[c])), hi);
+            base[0][j] = std::min(K::of(node.bounds.min[c]), lo);
+            base[1][j] = std::max(K::of(node.bounds.max[c]), hi);
         } else {
             // No cells: empty bounds whose end is the base (min = base, max = base - 1 for a lower
             // anchor; max = base, min = base + 1 for an upper one); the cap's own range where it can.
             base[0][j] = std::max(lo, uint8_t(1));
             base[1][j] = std::min(hi, uint8_t(254));
         }
-        for (int a = 0; a < 2; ++a)
-            for (int k = 0; k < 8; ++k) {
-                const uint8_t v = K::of(caps[j].voxel[k]);
-                width[a] = std::max(width[a], unsigned(std::bit_width(unsigned(uint8_t(a ? base[a][j] - v : v - base[a][j])))));
-            }
+        for (int k = 0; k < 8; ++k) {
+            width[0] = std::max(width[0], unsigned(std::bit_width(unsigned(uint8_t(key[j][k] - base[0][j])))));
+            width[1] = std::max(width[1], unsigned(std::bit_width(unsigned(uint8_t(base[1][j] - key[j][k])))));
+        }
         ++j;
     }
     const int a = width[1] < width[0] ? 1 : 0;   // the narrower; lower on a tie
@@ -103,7 +106,7 @@ template <typename T> uint64_t pack_anchored_caps(InteriorNode<T>& node, const C
         // Delta k at bits [k b, (k+1) b), counted up from the lowest value the deltas reach.
         const uint8_t from = uint8_t(a ? b - ((1u << bits) - 1u) : b);
         uint64_t word = 0;
-        for (int k = 0; k < 8; ++k) word |= uint64_t(uint8_t(uint8_t(K::of(caps[j].voxel[k])) - from)) << (k * bits);
+        for (int k = 0; k < 8; ++k) word |= uint64_t(uint8_t(key[j][k] - from)) << (k * bits);
         node.scalar[c] = K::value(uint8_t(word));
         const uint64_t rest = word >> 8;
         std::memcpy(out + uint64_t(j) * record, &rest, record);

@@ -277,8 +277,6 @@ TEST(OctReject, CompactNodeFieldsAreValidated) {
     }, "the cap level must end with 8 zero bytes");
 }
 
-/// Format 5 (issue 19): the zero bytes between an interior level's records and its group bases
-/// (u8 records are 28 bytes, so a level of one node has 4), and the zero tail of a double record.
 /// Format 6's 1-byte cap field (CapAnchor, octree.h): a width of 1 .. 8 below the anchor bit, 0
 /// only in a cap parent without stored children. Each refusal names the field and the value.
 TEST(OctReject, OneByteCapWidthsAreValidated) {
@@ -303,6 +301,8 @@ TEST(OctReject, OneByteCapWidthsAreValidated) {
     expect(0x80, "found 128 with child_mask " + stored);
 }
 
+/// Format 5 (issue 19): the zero bytes between an interior level's records and its group bases
+/// (u8 records are 28 bytes, so a level of one node has 4), and the zero tail of a double record.
 TEST(OctReject, GroupPaddingAndRecordTailMustBeZero) {
     {
         Fixture fx;

@@ -181,19 +181,20 @@ template <typename T> void expect_both_anchors_exact() {
     for (uint64_t i = 0; i < tree.node_count(d); ++i) {
         const InteriorNode<T>& n = tree.node(d, i);
         if (n.child_mask == 0) continue;
-        ++anchors[n.cap_bits >> kCapAnchorShift];
+        const bool upper = n.cap_anchor() == CapAnchor::upper;
+        ++anchors[upper];
         EXPECT_GE(n.cap_width(), 1u);
         EXPECT_LE(n.cap_width(), 8u);
-        // The base is a bound of each cap child, and the bounds still cover its cells.
-        for (int c = 0; c < 8; ++c)
-            if (!n.is_scalar_leaf(c)) {
-                T voxel[8];
-                tree.cap(i, n, c).decode(voxel);
-                for (T x : voxel)
-                    if (n.bounds.empty(c)) continue;
-                    else if (n.cap_bits >> kCapAnchorShift) EXPECT_LE(x, n.bounds.max[c]);
-                    else EXPECT_GE(x, n.bounds.min[c]);
+        // A cap child with cells keeps its anchor's bound on the far side of every voxel.
+        for (int c = 0; c < 8; ++c) {
+            if (n.is_scalar_leaf(c) || n.bounds.empty(c)) continue;
+            T voxel[8];
+            tree.cap(i, n, c).decode(voxel);
+            for (T x : voxel) {
+                if (upper) EXPECT_LE(x, n.bounds.max[c]);
+                else EXPECT_GE(x, n.bounds.min[c]);
             }
+        }
     }
     EXPECT_GT(anchors[0], 0u) << "no parent took the lower bound";
     EXPECT_GT(anchors[1], 0u) << "no parent took the upper bound";

@@ -53,7 +53,7 @@ template <typename T> void expect_random_parents_round_trip(uint32_t seed) {
         OctreeArrays<T> arrays;
         arrays.caps = level.data();
         const Octree<T> tree(arrays);
-        const bool upper = (node.cap_bits >> kCapAnchorShift) != 0;
+        const bool upper = node.cap_anchor() == CapAnchor::upper;
         for (int c = 0, j = 0; c < 8; ++c) {
             if (node.is_scalar_leaf(c)) continue;
             const CapRef<T> ref = tree.cap_at(0, node, c);
