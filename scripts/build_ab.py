@@ -8,11 +8,13 @@ same pixels (idiff -fail 0: a change meant to keep the image must).
 
     scripts/build_ab.py --a /work/wt-old/build/octiso-render [--b build/octiso-render] [--pairs 5]
                         [--threads 1] [--size 512x512] [--orbit 8] [--flags '--no-embree']
-                        [--colour] [--phase trace|shade] [--results DIR] [--tag NAME] FILE.oct[,B_FILE.oct]@ISO ...
+                        [--colour] [--phase trace|shade|other|frame] [--results DIR] [--tag NAME] FILE.oct[,B_FILE.oct]@ISO ...
 
 --colour also writes the colour image and compares it; --phase shade times the shading pass instead
 of the tile loop: with --colour --flags '--no-embree --ao 4' that is the ambient-occlusion rays,
-single rays from the hits in random directions (the renderer's incoherent rays).
+single rays from the hits in random directions (the renderer's incoherent rays). --phase frame times
+the whole frame (frame_seconds: tile loops, shading, and the rest such as the frame's buffers),
+--phase other only that rest.
 
 FILE.oct,B_FILE.oct: a format change, each build on its own conversion of the same voxels (A on FILE,
 B on B_FILE); the images are compared all the same.
@@ -39,6 +41,8 @@ def render(binary, path, iso, a, outdir, tag):
         cmd += [outputs[kind], os.path.join(outdir, f"{tag}_{kind}_%d.{ext}")]
     out = subprocess.run(cmd + a.flags.split(), check=True, capture_output=True, text=True).stdout
     frames = json.loads(out)["frames"]
+    if a.phase == "frame":   # the whole frame: tile loops, shading and the rest (buffers)
+        return sum(f["frame_seconds"] for f in frames) / len(frames)
     return sum(f["phases"][a.phase] for f in frames) / len(frames)
 
 
@@ -62,7 +66,8 @@ def main():
     p.add_argument("--orbit", type=int, default=8)
     p.add_argument("--flags", default="--no-embree")
     p.add_argument("--colour", action="store_true", help="also write and compare the colour image")
-    p.add_argument("--phase", default="trace", choices=["trace", "shade"], help="the phase timed (phases of --json)")
+    p.add_argument("--phase", default="trace", choices=["trace", "shade", "other", "frame"],
+                   help="the phase timed (phases of --json; frame: frame_seconds, all of them)")
     p.add_argument("--results")
     p.add_argument("--tag", default="", help="the JSON is build_ab_TAG.json")
     a = p.parse_args()

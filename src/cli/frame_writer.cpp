@@ -36,6 +36,13 @@ void FrameWriter::finish() {
     rethrow_failure();
 }
 
+Frame FrameWriter::take_written() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    Frame frame;
+    if (written_) frame = std::move(*written_), written_.reset();
+    return frame;
+}
+
 void FrameWriter::run() {
     for (;;) {
         std::unique_lock<std::mutex> lock(mutex_);
@@ -56,6 +63,7 @@ void FrameWriter::run() {
         if (job.seconds) *job.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         lock.lock();
         busy_ = false;
+        written_ = std::move(job.frame);
         if (failed && !failure_) failure_ = failed;
         if (failure_) waiting_.reset();   // nothing is written after a failure
         lock.unlock();

@@ -2,7 +2,8 @@
 // frame renders (issue 12). Encoding is serial: a 1024^2 PNG with its depth and normal EXRs took
 // 60-80 ms of one core per frame (ch2better, octiso-render --json "write"), more than a 16-thread
 // trace of it, so written in line it bounded many-core batch rendering. At most one frame waits
-// while another is written, so memory stays two frames above the renderer's.
+// while another is written, and the renderer allocates a frame only when no written one has come
+// back (take_written), so a series holds three frames at most, as before the frames came back.
 #pragma once
 
 #include <condition_variable>
@@ -33,6 +34,11 @@ public:
     void submit(Frame frame, Write write, double* seconds);
     /// Waits until every frame handed over is written; rethrows the first failure.
     void finish();
+    /// The latest frame written, its buffers kept for the next frame to render into (an empty
+    /// Frame if none is back yet). A fresh 512^2 frame's buffers cost page faults and zeroing
+    /// on every frame of a series; a returned one is resized in place (BENCHMARKS "Frame reuse in a
+    /// series").
+    Frame take_written();
 
 private:
     struct Job {
@@ -46,6 +52,7 @@ private:
     std::mutex mutex_;
     std::condition_variable changed_;
     std::optional<Job> waiting_;   // the next frame to write
+    std::optional<Frame> written_; // the latest frame written, for take_written()
     bool busy_ = false, stop_ = false;
     std::exception_ptr failure_;
     std::thread thread_;

@@ -19,6 +19,7 @@
 #include "render/pinhole_camera.h"
 #include "render/shade.h"
 #include "render/tile_loop.h"
+#include "util/huge_pages.h"
 #include "util/shared_arena.h"
 #include "render/tracer_kernel.h"
 #include "scene/embree_scene.h"
@@ -208,10 +209,11 @@ void Renderer::prepare_frame(const Camera& camera, Frame& frame) const {
     const size_t pixels = size_t(camera.width) * size_t(camera.height);
     frame.width = camera.width;
     frame.height = camera.height;
-    // Every pixel of a traced tile is written, so reused buffers need no clearing.
-    frame.rgb.resize(o.want_colour ? pixels * 3 : 0);
-    frame.depth.resize(o.want_depth ? pixels : 0);
-    frame.normal.resize(o.want_normal ? pixels * 3 : 0);
+    // Every pixel of a traced tile is written, so reused buffers need no clearing; fresh ones
+    // are faulted in on huge pages (util/huge_pages.h).
+    resize_on_huge_pages(frame.rgb, o.want_colour ? pixels * 3 : 0);
+    resize_on_huge_pages(frame.depth, o.want_depth ? pixels : 0);
+    resize_on_huge_pages(frame.normal, o.want_normal ? pixels * 3 : 0);
     frame.stats = {};
 }
 

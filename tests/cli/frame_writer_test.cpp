@@ -1,6 +1,7 @@
 // FrameWriter (src/cli/frame_writer.h): octiso-render's writer thread. Every frame handed over is
 // written, in order, by finish(); a failed write is rethrown to the renderer at its next call and
-// nothing after it is written; dropping the writer with frames waiting neither hangs nor writes them.
+// nothing after it is written; dropping the writer with frames waiting neither hangs nor writes them;
+// the latest frame written comes back, buffers and all, once.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -32,6 +33,22 @@ TEST(FrameWriter, EveryFrameIsWrittenInOrderWithItsTime) {
     writer.finish();
     EXPECT_EQ(written, (std::vector<int>{1, 2, 3, 4, 5}));
     for (double s : seconds) EXPECT_GE(s, 0.0);
+}
+
+TEST(FrameWriter, TheLatestWrittenFrameComesBackWithItsBuffersOnce) {
+    cli::FrameWriter writer;
+    EXPECT_EQ(writer.take_written().width, 0) << "nothing written yet: an empty frame";
+    std::vector<double> seconds(2, 0.0);
+    Frame first = frame_of_width(7), second = frame_of_width(9);
+    const uint8_t* second_pixels = second.rgb.data();
+    writer.submit(std::move(first), [](const Frame&) {}, &seconds[0]);
+    writer.submit(std::move(second), [](const Frame&) {}, &seconds[1]);
+    writer.finish();
+    Frame back = writer.take_written();
+    EXPECT_EQ(back.width, 9) << "the latest written, the earlier one freed";
+    EXPECT_EQ(back.rgb.data(), second_pixels) << "its buffers moved back, not copied";
+    EXPECT_EQ(back.rgb, std::vector<uint8_t>(27, uint8_t(9)));
+    EXPECT_EQ(writer.take_written().width, 0) << "taken once";
 }
 
 TEST(FrameWriter, AFailedWriteIsRethrownAndNothingAfterItIsWritten) {
