@@ -30,6 +30,7 @@
 #include "octiso/error.h"
 #include "render/pinhole_camera.h"
 #include "render/tile_loop.h"
+#include "util/huge_pages.h"
 
 namespace octiso::bench {
 
@@ -156,11 +157,11 @@ void render_mesh_frame(const MeshScene& ms, const Camera& camera, bool vertex_no
     const PinholeCamera pinhole(camera);
     const int W = camera.width, H = camera.height;
     frame.width = W, frame.height = H;
-    frame.depth.assign(size_t(W) * H, 0.0f);
-    frame.normal.assign(size_t(W) * H * 3, 0.0f);
+    assign_on_huge_pages(frame.depth, size_t(W) * H, 0.0f);   // as octiso's frames (util/huge_pages.h)
+    assign_on_huge_pages(frame.normal, size_t(W) * H * 3, 0.0f);
     if (geometric) {
         geometric->width = W, geometric->height = H;
-        geometric->normal.assign(size_t(W) * H * 3, 0.0f);
+        assign_on_huge_pages(geometric->normal, size_t(W) * H * 3, 0.0f);
     }
     const Mesh& mesh = ms.mesh;
     std::atomic<uint64_t> hits{0};

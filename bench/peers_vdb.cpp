@@ -37,6 +37,7 @@ VdbPeerResult run_vdb_peer(const LoadedVolume&, double, const Camera&) {
 #include "bench/bench.h"
 #include "render/pinhole_camera.h"
 #include "render/tile_loop.h"
+#include "util/huge_pages.h"
 
 namespace octiso::bench {
 
@@ -160,8 +161,8 @@ VdbPeerResult run_vdb_peer(const LoadedVolume& volume, double iso, const Camera&
     auto render_once = [state, pinhole, W, H](Frame& frame) {
         const Intersector& master = *state->master;
         frame.width = W, frame.height = H;
-        frame.depth.assign(size_t(W) * H, 0.0f);
-        frame.normal.assign(size_t(W) * H * 3, 0.0f);
+        assign_on_huge_pages(frame.depth, size_t(W) * H, 0.0f);   // as octiso's frames (util/huge_pages.h)
+        assign_on_huge_pages(frame.normal, size_t(W) * H * 3, 0.0f);
         tbb::enumerable_thread_specific<Intersector> per_thread(master);
         std::atomic<uint64_t> hits{0};
         const auto start = std::chrono::steady_clock::now();

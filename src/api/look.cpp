@@ -27,6 +27,7 @@
 #include "render/tile_loop.h"
 #include "render/tracer_kernel.h"
 #include "util/shared_arena.h"
+#include "util/huge_pages.h"
 
 namespace octiso {
 
@@ -105,7 +106,7 @@ LookStats LookShader::shade(const Camera& camera, const Shading& shading, Frame&
     const size_t pixels = size_t(frame.width) * size_t(frame.height);
     if (frame.depth.size() != pixels || frame.normal.size() != 3 * pixels || frame.width != camera.width || frame.height != camera.height)
         throw Error("LookShader::shade", "needs the depth and normal AOVs of the frame", ErrorKind::Other);
-    frame.rgb.resize(3 * pixels);
+    resize_on_huge_pages(frame.rgb, 3 * pixels);
     const PinholeCamera pinhole(camera);
     CameraFrame cam;
     cam.forward = vec_normalized(vec_sub(camera.look, camera.eye));

@@ -15,6 +15,7 @@
 #include "render/pinhole_camera.h"
 #include "render/shade.h"
 #include "util/shared_arena.h"
+#include "util/huge_pages.h"
 
 namespace octiso {
 
@@ -29,7 +30,7 @@ void shade_frame(const AnyOctree& tree, const std::vector<double>& isovalues, co
     const size_t pixels = size_t(frame.width) * size_t(frame.height);
     if (frame.depth.size() != pixels || frame.normal.size() != 3 * pixels)
         throw Error("shade_frame", "needs the depth and normal AOVs of the frame", ErrorKind::Other);
-    frame.rgb.resize(3 * pixels);
+    resize_on_huge_pages(frame.rgb, 3 * pixels);
     const PinholeCamera pinhole(camera);
     CameraFrame cam;
     cam.forward = vec_normalized(vec_sub(camera.look, camera.eye));

@@ -8,6 +8,7 @@
 
 #include "octiso/error.h"
 #include "render/pinhole_camera.h"
+#include "util/huge_pages.h"
 
 namespace octiso {
 
@@ -16,8 +17,8 @@ Frame render_reference(const VolumeView<T>& volume, const Placement& placement, 
                        const std::vector<double>& isovalues) {
     Frame f;
     f.width = camera.width, f.height = camera.height;
-    f.depth.assign(size_t(f.width) * f.height, INFINITY);
-    f.normal.assign(size_t(f.width) * f.height * 3, 0.0f);
+    assign_on_huge_pages(f.depth, size_t(f.width) * f.height, float(INFINITY));
+    assign_on_huge_pages(f.normal, size_t(f.width) * f.height * 3, 0.0f);
     const PinholeCamera pinhole(camera);
     tbb::parallel_for(0, f.height, [&](int py) {
         for (int px = 0; px < f.width; ++px) {

@@ -12,6 +12,7 @@
 #include "octiso/tiles.h"
 #include "render/pinhole_camera.h"
 #include "render/tile_loop.h"
+#include "util/huge_pages.h"
 
 namespace octiso {
 
@@ -22,8 +23,8 @@ template <class Tracer> Frame trace_frame(const Tracer& tracer, const Camera& ca
     Frame frame;
     frame.width = W;
     frame.height = H;
-    frame.depth.assign(size_t(W) * H, INFINITY);
-    if (want_normal) frame.normal.assign(size_t(W) * H * 3, 0.0f);
+    assign_on_huge_pages(frame.depth, size_t(W) * H, float(INFINITY));   // as the Renderer's (util/huge_pages.h)
+    if (want_normal) assign_on_huge_pages(frame.normal, size_t(W) * H * 3, 0.0f);
     frame.stats = for_each_tile(TileGrid{W, H, tile_size}, {}, true, [&](const PixelRect& rect, TileCounters& counters) {
         for (int py = rect.y0; py < rect.y1; ++py)
             for (int px = rect.x0; px < rect.x1; ++px) {

@@ -5,6 +5,7 @@
 // changes (BENCHMARKS "Frame buffers: reuse and huge pages").
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -25,6 +26,13 @@ template <typename T> void resize_on_huge_pages(std::vector<T>& v, size_t n) {
         v.swap(fresh);
     }
     v.resize(n);
+}
+
+/// v.assign(n, value) on resize_on_huge_pages's buffer: for buffers that start at a fill value
+/// (the reference tracers' and the peers' frames, which write only their hits).
+template <typename T> void assign_on_huge_pages(std::vector<T>& v, size_t n, const T& value) {
+    resize_on_huge_pages(v, n);
+    std::fill(v.begin(), v.end(), value);
 }
 
 }  // namespace octiso
