@@ -36,8 +36,8 @@ public:
     void finish();
     /// The latest frame written, its buffers kept for the next frame to render into (an empty
     /// Frame if none is back yet). A fresh 512^2 frame's buffers cost page faults and zeroing
-    /// on every frame of a series; a returned one is resized in place (BENCHMARKS "Frame reuse in a
-    /// series").
+    /// on every frame of a series; a returned one is resized in place (BENCHMARKS "Frame buffers:
+    /// reuse in a series and huge pages").
     Frame take_written();
 
 private:

@@ -356,7 +356,7 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
     if (jobs.size() > 1) writer.emplace();
     // The previous frame's buffers, rendered into again (a frame this rank did not hand to the
     // writer, else the writer's latest written one): a fresh frame's buffers are page faults and
-    // zeroing on every frame of a series (BENCHMARKS "Frame reuse in a series").
+    // zeroing on every frame of a series (BENCHMARKS "Frame buffers").
     Frame spare_frame;
     const auto wall_start = std::chrono::steady_clock::now();
     const auto render_job = [&](size_t n) {

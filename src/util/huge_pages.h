@@ -1,8 +1,9 @@
 // Large buffers that a frame writes whole (colour, depth, normal) on transparent huge pages.
 // A fresh 1024^2 frame is 20 MiB of buffers: 5000 page faults of 4 KiB, which on this VM cost
-// 50-65 ms, a third of a 2-thread trace of ch2better (octiso-render --json "other"); on 2 MiB
-// pages they are ten. Where THP is off (enabled = never) the advice is a no-op and nothing else
-// changes (BENCHMARKS "Frame buffers: reuse and huge pages").
+// 44-47 ms, a third of a 2-thread trace of ch2better (octiso-render --json "other"); on 2 MiB
+// pages 12-13 ms are left, and the frame takes 0.77-0.80 x the time. Where THP is off (enabled =
+// never) the advice is a no-op and nothing else changes (BENCHMARKS "Frame buffers: reuse in a
+// series and huge pages").
 #pragma once
 
 #include <algorithm>
