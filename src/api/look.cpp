@@ -26,8 +26,8 @@
 #include "render/shade.h"
 #include "render/tile_loop.h"
 #include "render/tracer_kernel.h"
-#include "util/shared_arena.h"
 #include "util/huge_pages.h"
+#include "util/shared_arena.h"
 
 namespace octiso {
 

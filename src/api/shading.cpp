@@ -14,8 +14,8 @@
 #include "render/light_kit.h"
 #include "render/pinhole_camera.h"
 #include "render/shade.h"
-#include "util/shared_arena.h"
 #include "util/huge_pages.h"
+#include "util/shared_arena.h"
 
 namespace octiso {
 

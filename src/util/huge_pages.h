@@ -6,7 +6,6 @@
 // series and huge pages").
 #pragma once
 
-#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -17,23 +16,27 @@ namespace octiso {
 /// kernels without THP, are left alone. Never fails: it is advice.
 void advise_huge_pages(void* data, size_t bytes);
 
-/// v.resize(n), with a fresh allocation advised onto huge pages before any of it is touched
-/// (the contents are not kept: for buffers every element of which is written next).
+/// Makes v's capacity at least n: a fresh allocation advised onto huge pages before any of it
+/// is touched (the contents are not kept: for buffers every element of which is written next).
+template <typename T> void reserve_on_huge_pages(std::vector<T>& v, size_t n) {
+    if (v.capacity() >= n) return;
+    std::vector<T> fresh;
+    fresh.reserve(n);
+    advise_huge_pages(fresh.data(), n * sizeof(T));
+    v.swap(fresh);
+}
+
+/// v.resize(n) into reserve_on_huge_pages's buffer (the frame's traced buffers).
 template <typename T> void resize_on_huge_pages(std::vector<T>& v, size_t n) {
-    if (v.capacity() < n) {
-        std::vector<T> fresh;
-        fresh.reserve(n);
-        advise_huge_pages(fresh.data(), n * sizeof(T));
-        v.swap(fresh);
-    }
+    reserve_on_huge_pages(v, n);
     v.resize(n);
 }
 
-/// v.assign(n, value) on resize_on_huge_pages's buffer: for buffers that start at a fill value
-/// (the reference tracers' and the peers' frames, which write only their hits).
+/// v.assign(n, value) into reserve_on_huge_pages's buffer, one pass over it: for buffers that
+/// start at a fill value (the reference tracers' and the peers' frames, which write only hits).
 template <typename T> void assign_on_huge_pages(std::vector<T>& v, size_t n, const T& value) {
-    resize_on_huge_pages(v, n);
-    std::fill(v.begin(), v.end(), value);
+    reserve_on_huge_pages(v, n);
+    v.assign(n, value);
 }
 
 }  // namespace octiso
