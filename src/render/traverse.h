@@ -57,6 +57,15 @@ OCTISO_ALWAYS_INLINE void load4(V4d& v, const double* p) { std::memcpy(&v, p, si
 OCTISO_ALWAYS_INLINE void store4(double* p, const V4d& v) { std::memcpy(p, &v, sizeof v); }
 #endif
 
+/// Blocks of a cap's corner lattice (OctreeTracer::CapBlocks) whose voxels the cell of octant `oct`
+/// reads: every block r with r & ~oct == 0.
+constexpr unsigned cap_blocks_of_octant(int oct) {
+    unsigned m = 0;
+    for (int r = 0; r < 8; ++r)
+        if ((r & ~oct) == 0) m |= 1u << r;
+    return m;
+}
+
 /// The default corner source: the octree itself (in-cap reads and neighbour finding). Any other
 /// Corners type provides `void gather(Coord cell, double corner[8]) const` and replaces every
 /// corner read (e.g. ArrayCorners<T> in src/reference/macrocell.h); the octree then only culls.
@@ -541,9 +550,6 @@ private:
         PacketSplit split;
         split.split(*this, p, co, 1, active, t0, t1);
         const Dims dims = tree_.dims();
-        static constexpr unsigned kNeeds[8] = {blocks_of_octant(0), blocks_of_octant(1), blocks_of_octant(2), blocks_of_octant(3),
-                                               blocks_of_octant(4), blocks_of_octant(5), blocks_of_octant(6), blocks_of_octant(7)};
-        static constexpr int kOffset[8] = {0, 9, 3, 12, 1, 10, 4, 13};
         for (unsigned i = 0; i < 8 && active; ++i) {
             const unsigned c = i ^ unsigned(flip);
             const unsigned entered = split.enter(c, active);
@@ -553,11 +559,11 @@ private:
             // Beyond the last data cell (padding): stepped over, as visit_cell does.
             if (int64_t(v.x) > int64_t(dims.x) - 2 || int64_t(v.y) > int64_t(dims.y) - 2 || int64_t(v.z) > int64_t(dims.z) - 2)
                 continue;
-            const unsigned need = kNeeds[c];
+            const unsigned need = kCellBlocks[c];
             if ((blocks.ready & need) != need) fill_cap_blocks(blocks, need & ~blocks.ready, ref, co, p.trace);
             const double* at = blocks.lattice + (9 * x + 3 * y + z);
             double corner[8];
-            for (int k = 0; k < 8; ++k) corner[k] = at[kOffset[k]];
+            for (int k = 0; k < 8; ++k) corner[k] = at[kCellCorner[k]];
             double lo = corner[0], hi = corner[0];
             for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
             if (!scene_.any_iso_in(lo, hi)) continue;   // intersect_cell's own cull, once per packet
@@ -582,13 +588,12 @@ private:
         return mask;
     }
 
-    /// Blocks whose voxels a cell of octant `oct` of a cap reads: every block r with r & ~oct == 0.
-    static constexpr unsigned blocks_of_octant(int oct) {
-        unsigned m = 0;
-        for (int r = 0; r < 8; ++r)
-            if ((r & ~oct) == 0) m |= 1u << r;
-        return m;
-    }
+    /// Per cell of a cap (octant bits), the lattice blocks its corners lie in.
+    static constexpr unsigned kCellBlocks[8] = {cap_blocks_of_octant(0), cap_blocks_of_octant(1), cap_blocks_of_octant(2), cap_blocks_of_octant(3),
+                                                cap_blocks_of_octant(4), cap_blocks_of_octant(5), cap_blocks_of_octant(6), cap_blocks_of_octant(7)};
+    /// Corner i + 2j + 4k of a cap's cell is lattice point (x + i, y + j, z + k): its offset from
+    /// the cell's lower corner in CapBlocks::lattice (9 x + 3 y + z).
+    static constexpr int kCellCorner[8] = {0, 9, 3, 12, 1, 10, 4, 13};
 
     /// Locates entry q of `parent` (CapParent), the cap parent holding `co`, from its trace.
     [[gnu::noinline]] void locate_cap_parent(CapParent& parent, int q, const Coord& co, const uint32_t* trace) const {
@@ -651,20 +656,17 @@ private:
                 return;
             }
             const uint32_t x = v.x - co.x, y = v.y - co.y, z = v.z - co.z;
-            static constexpr unsigned kNeeds[8] = {blocks_of_octant(0), blocks_of_octant(1), blocks_of_octant(2), blocks_of_octant(3),
-                                                   blocks_of_octant(4), blocks_of_octant(5), blocks_of_octant(6), blocks_of_octant(7)};
             const bool on_ghost = cap_on_ghost && v.x + 1 == owned_.hi[0];
             // On the ghost plane the +x corners come from it, not from the blocks beyond the box.
-            const unsigned need = kNeeds[(x << 2) | (y << 1) | z] & (on_ghost ? 0x0Fu : 0xFFu);
+            const unsigned need = kCellBlocks[(x << 2) | (y << 1) | z] & (on_ghost ? 0x0Fu : 0xFFu);
             if ((blocks.ready & need) != need) fill_cap_blocks(blocks, need & ~blocks.ready, ref, co, trace);
             // Corner i + 2j + 4k of the cell is lattice point (x + i, y + j, z + k).
             const double* at = blocks.lattice + (9 * x + 3 * y + z);
-            static constexpr int kOffset[8] = {0, 9, 3, 12, 1, 10, 4, 13};
             if (on_ghost) [[unlikely]] {
-                for (int k = 0; k < 8; ++k) corner[k] = (k & 1) ? ghost_value(v, k) : at[kOffset[k]];
+                for (int k = 0; k < 8; ++k) corner[k] = (k & 1) ? ghost_value(v, k) : at[kCellCorner[k]];
                 return;
             }
-            for (int k = 0; k < 8; ++k) corner[k] = at[kOffset[k]];
+            for (int k = 0; k < 8; ++k) corner[k] = at[kCellCorner[k]];
         });
     }
 
