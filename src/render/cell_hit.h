@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "octiso/inline.h"
 #include "octiso/octree.h"
 #include "math/hit.h"
 #include "math/ray.h"
@@ -103,17 +104,21 @@ inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RaySt
     return true;
 }
 
-/// Tests cell v (lower corner, index space) with corners `corner` (order i + 2j + 4k) on the ray
-/// piece [t_in, t_out) ([t_in, t_out] when closed_end). On a hit fills `w.hit` and returns true.
+/// The range [lo, hi] of a cell's 8 corners: the cull every cell test starts with.
+OCTISO_ALWAYS_INLINE void corner_range(const double corner[8], double& lo, double& hi) {
+    lo = corner[0], hi = corner[0];
+    for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
+}
+
+/// intersect_cell after its cull, for a caller that has the corners' range [lo, hi] already (a
+/// packet's cell, culled once for all its lanes): the same root, bit for bit.
 template <class Finder>
-inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
-                           const double corner[8], double t_in, double t_out, bool closed_end) {
+OCTISO_ALWAYS_INLINE bool intersect_cell_in_range(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
+                                                  const double corner[8], double lo, double hi, double t_in, double t_out,
+                                                  bool closed_end) {
     OCTISO_DCHECK(double(v.x) + 1 <= scene.box_hi[0] && double(v.y) + 1 <= scene.box_hi[1] &&
                       double(v.z) + 1 <= scene.box_hi[2],
                   "cell (", v.x, ",", v.y, ",", v.z, ") outside the data box");
-    double lo = corner[0], hi = corner[0];
-    for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
-    if (!scene.any_iso_in(lo, hi)) return false;   // a NaN corner fails every comparison
     const IndexRay& r = w.ray;
     const std::array<double, 3> o_cell{r.origin[0] - double(v.x), r.origin[1] - double(v.y), r.origin[2] - double(v.z)};
     std::array<double, 3> p_in, p_out;
@@ -122,6 +127,17 @@ inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, Ray
         p_out[a] = snap_to_face(o_cell[a] + t_out * r.dir[a]);
     }
     return nearest_root(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end, scene.placement.spacing);
+}
+
+/// Tests cell v (lower corner, index space) with corners `corner` (order i + 2j + 4k) on the ray
+/// piece [t_in, t_out) ([t_in, t_out] when closed_end). On a hit fills `w.hit` and returns true.
+template <class Finder>
+inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
+                           const double corner[8], double t_in, double t_out, bool closed_end) {
+    double lo, hi;
+    corner_range(corner, lo, hi);
+    if (!scene.any_iso_in(lo, hi)) return false;   // a NaN corner fails every comparison
+    return intersect_cell_in_range(finder, scene, w, v, corner, lo, hi, t_in, t_out, closed_end);
 }
 
 /// Level of detail (lod.h): intersect_cell on the coarse cell with lower corner v and sides
@@ -133,8 +149,8 @@ template <class Finder>
 inline bool intersect_coarse_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
                                   const uint32_t extent[3], const double corner[8], double t_in, double t_out,
                                   bool closed_end) {
-    double lo = corner[0], hi = corner[0];
-    for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
+    double lo, hi;
+    corner_range(corner, lo, hi);
     if (!scene.any_iso_in(lo, hi)) return false;
     const IndexRay& r = w.ray;
     const double base[3] = {double(v.x), double(v.y), double(v.z)};

@@ -549,30 +549,27 @@ private:
                         const double* t1, CapBlocks& blocks) const {
         PacketSplit split;
         split.split(*this, p, co, 1, active, t0, t1);
-        const Dims dims = tree_.dims();
         for (unsigned i = 0; i < 8 && active; ++i) {
             const unsigned c = i ^ unsigned(flip);
             const unsigned entered = split.enter(c, active);
             if (!entered) continue;
             const uint32_t x = (c >> 2) & 1u, y = (c >> 1) & 1u, z = c & 1u;
-            const Coord v{co.x + x, co.y + y, co.z + z};
-            // Beyond the last data cell (padding): stepped over, as visit_cell does.
-            if (int64_t(v.x) > int64_t(dims.x) - 2 || int64_t(v.y) > int64_t(dims.y) - 2 || int64_t(v.z) > int64_t(dims.z) - 2)
-                continue;
-            const unsigned need = kCellBlocks[c];
-            if ((blocks.ready & need) != need) fill_cap_blocks(blocks, need & ~blocks.ready, ref, co, p.trace);
-            const double* at = blocks.lattice + (9 * x + 3 * y + z);
+            const int64_t cell[3] = {int64_t(co.x) + x, int64_t(co.y) + y, int64_t(co.z) + z};
+            if (past_last_cell(cell)) continue;   // padding, as in visit_cell
+            const double* at = cap_cell_lattice(blocks, kCellBlocks[c], ref, co, x, y, z, p.trace);
             double corner[8];
             for (int k = 0; k < 8; ++k) corner[k] = at[kCellCorner[k]];
-            double lo = corner[0], hi = corner[0];
-            for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
-            if (!scene_.any_iso_in(lo, hi)) continue;   // intersect_cell's own cull, once per packet
+            double lo, hi;
+            corner_range(corner, lo, hi);
+            if (!scene_.any_iso_in(lo, hi)) continue;   // intersect_cell's cull, once for the packet
+            const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
             const double* c0 = split.lo(c);
             const double* c1 = split.hi(c);
             for (unsigned m = entered; m; m &= m - 1) {
                 const int k = std::countr_zero(m);
                 Walk& w = p.lane[k];
-                if (intersect_cell(finder_, scene_, w, v, corner, c0[k], c1[k], c1[k] == w.t_exit)) active &= ~(1u << k);
+                if (intersect_cell_in_range(finder_, scene_, w, v, corner, lo, hi, c0[k], c1[k], c1[k] == w.t_exit))
+                    active &= ~(1u << k);
             }
         }
         return active;
@@ -594,6 +591,20 @@ private:
     /// Corner i + 2j + 4k of a cap's cell is lattice point (x + i, y + j, z + k): its offset from
     /// the cell's lower corner in CapBlocks::lattice (9 x + 3 y + z).
     static constexpr int kCellCorner[8] = {0, 9, 3, 12, 1, 10, 4, 13};
+
+    /// The corner lattice of the cap at `co` from its cell (x, y, z) (0 or 1 each) on, with the
+    /// blocks in `need` decoded first: corner i + 2j + 4k of the cell is at kCellCorner[i + 2j + 4k].
+    OCTISO_ALWAYS_INLINE const double* cap_cell_lattice(CapBlocks& blocks, unsigned need, const CapRef<T>& ref, const Coord& co,
+                                                        uint32_t x, uint32_t y, uint32_t z, const uint32_t* trace) const {
+        if ((blocks.ready & need) != need) fill_cap_blocks(blocks, need & ~blocks.ready, ref, co, trace);
+        return blocks.lattice + (9 * x + 3 * y + z);
+    }
+
+    /// Whether a cell lies beyond the last data cell (padding of the octree's cube): never tested.
+    OCTISO_ALWAYS_INLINE bool past_last_cell(const int64_t cell[3]) const {
+        const Dims dims = tree_.dims();
+        return cell[0] > int64_t(dims.x) - 2 || cell[1] > int64_t(dims.y) - 2 || cell[2] > int64_t(dims.z) - 2;
+    }
 
     /// Locates entry q of `parent` (CapParent), the cap parent holding `co`, from its trace.
     [[gnu::noinline]] void locate_cap_parent(CapParent& parent, int q, const Coord& co, const uint32_t* trace) const {
@@ -659,9 +670,7 @@ private:
             const bool on_ghost = cap_on_ghost && v.x + 1 == owned_.hi[0];
             // On the ghost plane the +x corners come from it, not from the blocks beyond the box.
             const unsigned need = kCellBlocks[(x << 2) | (y << 1) | z] & (on_ghost ? 0x0Fu : 0xFFu);
-            if ((blocks.ready & need) != need) fill_cap_blocks(blocks, need & ~blocks.ready, ref, co, trace);
-            // Corner i + 2j + 4k of the cell is lattice point (x + i, y + j, z + k).
-            const double* at = blocks.lattice + (9 * x + 3 * y + z);
+            const double* at = cap_cell_lattice(blocks, need, ref, co, x, y, z, trace);
             if (on_ghost) [[unlikely]] {
                 for (int k = 0; k < 8; ++k) corner[k] = (k & 1) ? ghost_value(v, k) : at[kCellCorner[k]];
                 return;
@@ -743,8 +752,7 @@ private:
     template <class Gather>
     OCTISO_ALWAYS_INLINE bool visit_cell(RayState& w, const int64_t cell[3], double t_in, double t_out, bool closed_end,
                                          bool partial, Gather& gather) const {
-        const Dims dims = tree_.dims();
-        if (cell[0] > int64_t(dims.x) - 2 || cell[1] > int64_t(dims.y) - 2 || cell[2] > int64_t(dims.z) - 2) return false;
+        if (past_last_cell(cell)) return false;
         OCTISO_DCHECK(cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0, "cell below the data box");
         if (partial && !owns_cell(cell)) [[unlikely]] return false;
         const Coord v{uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])};
@@ -866,8 +874,8 @@ private:
 
     bool test_cell(RayState& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
         if constexpr (Recorder::kOn) {
-            double lo = corner[0], hi = corner[0];
-            for (int k = 1; k < 8; ++k) lo = std::min(lo, corner[k]), hi = std::max(hi, corner[k]);
+            double lo, hi;
+            corner_range(corner, lo, hi);
             recorder_.cell(v, t_in, t_out, closed_end, lo, hi);
             const bool hit = intersect_cell(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
             if (hit) recorder_.root(w.hit.t, w.hit.iso_index);
