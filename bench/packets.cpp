@@ -3,11 +3,12 @@
 // interleaved in one run (each round renders every method once, the first method rotating):
 //   octiso single, Embree  - the previous default: Embree rtcIntersect8, each lane traced alone
 //   octiso single          - one ray at a time, called directly (baseline build)
-//   octiso packets         - 8-ray packets, called directly, portable x86-64-v2 kernel
+//   octiso packets         - 16-ray packets of 4x4 pixels, called directly, portable x86-64-v2 kernel
 //   octiso packets AVX2    - the same, AVX2 kernel (when the CPU has it)
 //   octiso packets, Embree - the default path: Embree rtcIntersect8 hands its packet to the kernel
-//   mesh 1-ray / 8-ray     - vtkFlyingEdges3D + Embree HIGH robust, rtcIntersect1 / rtcIntersect8 over
-//                            8x1 rows and over 4x2 blocks (the mesh's best packet shape is its number)
+//   mesh 1-ray / 8-ray / 16-ray - vtkFlyingEdges3D + Embree HIGH robust, rtcIntersect1 / rtcIntersect8 over
+//                            8x1 rows and over 4x2 blocks / rtcIntersect16 over 4x4 blocks (the mesh's
+//                            best packet shape is its number)
 // Every octiso frame (depth and normal) is compared bit for bit with the single-ray one. Then the
 // packet threshold (lanes below which a packet splits into single rays) is swept, and incoherent
 // rays (random origins inside the data, random directions) are traced alone and in packets.
@@ -92,7 +93,7 @@ struct IncoherentRow {
 };
 
 /// Random rays from inside the data box in random directions, traced one by one and in packets of
-/// 8 through the same kernel; hits compared exactly.
+/// kMaxTracePacket (the renderer's direct packets) through the same kernel; hits compared exactly.
 template <typename T>
 IncoherentRow incoherent(const std::string& name, const Octree<T>& tree, const Placement& placement, double iso,
                          uint64_t count, int repeats) {
@@ -119,8 +120,9 @@ IncoherentRow incoherent(const std::string& name, const Octree<T>& tree, const P
         for (uint64_t i = 0; i < count; ++i) single[i] = kernel.trace(kernel.user, rays[i], true);
         row.single_s = std::min(row.single_s, thread_cpu_seconds() - t0);
         t0 = thread_cpu_seconds();
-        for (uint64_t i = 0; i < count; i += 8)
-            kernel.trace_packet(kernel.user, &rays[i], int(std::min<uint64_t>(8, count - i)), nullptr, true, &packed[i]);
+        for (uint64_t i = 0; i < count; i += kMaxTracePacket)
+            kernel.trace_packet(kernel.user, &rays[i], int(std::min<uint64_t>(kMaxTracePacket, count - i)), nullptr, true,
+                                &packed[i]);
         row.packet_s = std::min(row.packet_s, thread_cpu_seconds() - t0);
     }
     for (uint64_t i = 0; i < count; ++i) {
@@ -196,10 +198,11 @@ int run_packets(cli::Args& args) {
                 if (avx2) methods.push_back(octiso_method("octiso packets AVX2", Traversal::packets, Isa::avx2, false));
                 methods.push_back(octiso_method("octiso packets, Embree", Traversal::packets, Isa::automatic, true));
                 if (mesh) {
-                    for (MeshRays rays : {MeshRays::single, MeshRays::packet8, MeshRays::packet8_block}) {
-                        Method m{"mesh " + std::string(rays == MeshRays::single   ? "1-ray"
-                                                       : rays == MeshRays::packet8 ? "8-ray"
-                                                                                   : "8-ray 4x2"),
+                    for (MeshRays rays : {MeshRays::single, MeshRays::packet8, MeshRays::packet8_block, MeshRays::packet16_block}) {
+                        Method m{"mesh " + std::string(rays == MeshRays::single         ? "1-ray"
+                                                       : rays == MeshRays::packet8       ? "8-ray"
+                                                       : rays == MeshRays::packet8_block ? "8-ray 4x2"
+                                                                                         : "16-ray 4x4"),
                                  [&mesh, rays, threads](Frame*) {
                                      tbb::task_arena arena(threads);
                                      double s = 0;
@@ -279,21 +282,22 @@ int run_packets(cli::Args& args) {
     std::vector<std::string> header{"dataset", "iso", "image", "threads", "hits"};
     for (const auto& [name, s] : cases.front().min_seconds) header.push_back(name + " ms");
     header.push_back("packets/single");
-    header.push_back("best mesh 8-ray / best octiso");
+    header.push_back("best mesh packets / best octiso");
     header.push_back("identical");
     Table table(header);
     for (const CaseRow& r : cases) {
         std::vector<std::string> cells{r.dataset, fmt(r.iso, 1), std::to_string(r.image) + "^2", std::to_string(r.threads),
                                        std::to_string(r.hits)};
-        double best = INFINITY, mesh8 = NAN, before = NAN;
+        double best = INFINITY, mesh_packets = NAN, before = NAN;
         for (const auto& [name, s] : r.min_seconds) {
             cells.push_back(fmt(s * 1e3, 1));
             if (name == "octiso single, Embree") before = s;
             if (name.rfind("octiso packets", 0) == 0) best = std::min(best, s);
-            if (name.rfind("mesh 8-ray", 0) == 0) mesh8 = std::isnan(mesh8) ? s : std::min(mesh8, s);
+            if (name.rfind("mesh 8-ray", 0) == 0 || name.rfind("mesh 16-ray", 0) == 0)
+                mesh_packets = std::isnan(mesh_packets) ? s : std::min(mesh_packets, s);
         }
         cells.push_back(fmt(before / best, 2) + " x");
-        cells.push_back(std::isnan(mesh8) ? "-" : fmt(mesh8 / best, 2) + " x");
+        cells.push_back(std::isnan(mesh_packets) ? "-" : fmt(mesh_packets / best, 2) + " x");
         bool same = true;
         for (const auto& [name, ok] : r.identical) same &= ok;
         cells.push_back(same ? "yes" : "NO");
@@ -302,7 +306,7 @@ int run_packets(cli::Args& args) {
     std::cout << "packet traversal, frame time (min of " << repeats << ", interleaved; 1 thread: thread CPU time), depth + "
               << "normals, no shading (" << machine_description() << ")\n";
     std::cout << "packets/single = the previous default (single, Embree) / the fastest packet path; mesh = FE + Embree "
-                 "HIGH robust; mesh / octiso = the faster 8-ray mesh row / the fastest octiso packet path (1 = parity)\n";
+                 "HIGH robust; mesh / octiso = the fastest mesh packet row (8 or 16 rays) / the fastest octiso packet path (1 = parity)\n";
     if (markdown) table.print_markdown(std::cout);
     else table.print(std::cout);
     if (!thresholds.empty()) {

@@ -36,7 +36,10 @@ namespace octiso::bench {
 
 std::string bvh_quality_name(BvhQuality q) { return q == BvhQuality::high ? "high" : "medium"; }
 std::string mesh_rays_name(MeshRays r) {
-    return r == MeshRays::packet8 ? "rtcIntersect8" : r == MeshRays::packet8_block ? "rtcIntersect8 4x2" : "rtcIntersect1";
+    return r == MeshRays::packet8         ? "rtcIntersect8"
+           : r == MeshRays::packet8_block ? "rtcIntersect8 4x2"
+           : r == MeshRays::packet16_block ? "rtcIntersect16 4x4"
+                                          : "rtcIntersect1";
 }
 
 namespace {
@@ -202,43 +205,51 @@ void render_mesh_frame(const MeshScene& ms, const Camera& camera, bool vertex_no
             RTCIntersectContext context;
             rtcInitIntersectContext(&context);
             if (rays != MeshRays::single) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-            if (rays != MeshRays::single) {
+            // One packet of bw x bh pixels, one rtcIntersect8 / rtcIntersect16 call (RayHitN with N lanes).
+            const auto trace_block = [&]<class RayHitN, int N>(int x0, int y0, int bw, int bh, auto intersect) {
+                int count = 0;
+                Ray ray[N];
+                size_t pixel[N];
+                for (int py = y0; py < std::min(y0 + bh, tile.y1); ++py)
+                    for (int px = x0; px < std::min(x0 + bw, tile.x1); ++px) {
+                        ray[count] = pinhole.ray(px, py);
+                        pixel[count++] = size_t(py) * W + size_t(px);
+                    }
+                alignas(64) RayHitN rh{};
+                alignas(64) int valid[N];
+                for (int k = 0; k < N; ++k) {
+                    valid[k] = k < count ? -1 : 0;
+                    const Ray& r = ray[k < count ? k : 0];
+                    rh.ray.org_x[k] = float(r.origin[0]), rh.ray.org_y[k] = float(r.origin[1]);
+                    rh.ray.org_z[k] = float(r.origin[2]);
+                    rh.ray.dir_x[k] = float(r.dir[0]), rh.ray.dir_y[k] = float(r.dir[1]);
+                    rh.ray.dir_z[k] = float(r.dir[2]);
+                    rh.ray.tnear[k] = 0.0f;
+                    rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
+                    rh.ray.mask[k] = ~0u;   // Debian's Embree is built with ray masks: 0 would hit nothing
+                    rh.ray.flags[k] = 0;
+                    rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                    rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+                }
+                intersect(valid, ms.scene, &context, &rh);
+                for (int k = 0; k < count; ++k) {
+                    const float ng[3] = {rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]};
+                    tile_hits += shade(ray[k], pixel[k], rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID, rh.ray.tfar[k],
+                                       rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k], ng);
+                }
+            };
+            if (rays == MeshRays::packet16_block) {
+                // 4x4 blocks, one rtcIntersect16 each: the octree's own direct packet shape.
+                for (int y0 = tile.y0; y0 < tile.y1; y0 += 4)
+                    for (int x0 = tile.x0; x0 < tile.x1; x0 += 4)
+                        trace_block.template operator()<RTCRayHit16, 16>(x0, y0, 4, 4, rtcIntersect16);
+            } else if (rays != MeshRays::single) {
                 // Packets of 8 pixels, one rtcIntersect8 each: runs of a tile row (8x1, as render()
-                // fed Embree until issue 11) or 4x2 blocks (as render() does now).
+                // fed Embree until issue 11) or 4x2 blocks (as render() does through Embree).
                 const int bw = rays == MeshRays::packet8 ? 8 : 4, bh = 8 / bw;
                 for (int y0 = tile.y0; y0 < tile.y1; y0 += bh)
-                    for (int x0 = tile.x0; x0 < tile.x1; x0 += bw) {
-                        int count = 0;
-                        Ray ray[8];
-                        size_t pixel[8];
-                        for (int py = y0; py < std::min(y0 + bh, tile.y1); ++py)
-                            for (int px = x0; px < std::min(x0 + bw, tile.x1); ++px) {
-                                ray[count] = pinhole.ray(px, py);
-                                pixel[count++] = size_t(py) * W + size_t(px);
-                            }
-                        alignas(32) RTCRayHit8 rh{};
-                        alignas(32) int valid[8];
-                        for (int k = 0; k < 8; ++k) {
-                            valid[k] = k < count ? -1 : 0;
-                            const Ray& r = ray[k < count ? k : 0];
-                            rh.ray.org_x[k] = float(r.origin[0]), rh.ray.org_y[k] = float(r.origin[1]);
-                            rh.ray.org_z[k] = float(r.origin[2]);
-                            rh.ray.dir_x[k] = float(r.dir[0]), rh.ray.dir_y[k] = float(r.dir[1]);
-                            rh.ray.dir_z[k] = float(r.dir[2]);
-                            rh.ray.tnear[k] = 0.0f;
-                            rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
-                            rh.ray.mask[k] = ~0u;   // Debian's Embree is built with ray masks: 0 would hit nothing
-                            rh.ray.flags[k] = 0;
-                            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-                            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-                        }
-                        rtcIntersect8(valid, ms.scene, &context, &rh);
-                        for (int k = 0; k < count; ++k) {
-                            const float ng[3] = {rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]};
-                            tile_hits += shade(ray[k], pixel[k], rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID, rh.ray.tfar[k],
-                                               rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k], ng);
-                        }
-                    }
+                    for (int x0 = tile.x0; x0 < tile.x1; x0 += bw)
+                        trace_block.template operator()<RTCRayHit8, 8>(x0, y0, bw, bh, rtcIntersect8);
             } else for (int py = tile.y0; py < tile.y1; ++py) {
                 for (int px = tile.x0; px < tile.x1; ++px) {
                     const Ray ray = pinhole.ray(px, py);

@@ -19,8 +19,9 @@ enum class BvhQuality { medium, high };
 std::string bvh_quality_name(BvhQuality q);
 
 /// How the mesh's primary rays go to Embree.
-/// packet8: 8 pixels of a tile row per rtcIntersect8; packet8_block: 4x2 pixel blocks.
-enum class MeshRays { single, packet8, packet8_block };
+/// packet8: 8 pixels of a tile row per rtcIntersect8; packet8_block: 4x2 pixel blocks;
+/// packet16_block: 4x4 pixel blocks per rtcIntersect16.
+enum class MeshRays { single, packet8, packet8_block, packet16_block };
 std::string mesh_rays_name(MeshRays r);
 
 struct MeshPeerOptions {

@@ -72,15 +72,20 @@ struct Renderer::Impl {
 
 namespace {
 
-/// Pixels of `rect` into `frame`, one packet of up to kPacket pixels per kernel or Embree call:
-/// blocks of kPacketW x kPacketH pixels, whose rays stay closer together than a row's (more lanes
-/// share each node and cap; BENCHMARKS.md, packets: 4x2 against 8x1).
-constexpr int kPacketW = 4, kPacketH = 2;
-static_assert(kPacketW * kPacketH == EmbreeVolumeScene::kPacket);
+/// Pixels of `rect` into `frame`, one packet per kernel or Embree call: blocks of pixels, whose
+/// rays stay closer together than a row's (more lanes share each node and cap; BENCHMARKS.md,
+/// packets: 4x2 against 8x1). Through Embree 4x2 (one rtcIntersect8 packet); called directly
+/// 4x4 (kMaxTracePacket, tracer_kernel.h: the tracer's per-packet work shared by twice the rays).
+constexpr int kEmbreePacketW = 4, kEmbreePacketH = 2;
+static_assert(kEmbreePacketW * kEmbreePacketH == EmbreeVolumeScene::kPacket);
+constexpr int kDirectPacketW = 4, kDirectPacketH = 4;
+static_assert(kDirectPacketW * kDirectPacketH == kMaxTracePacket);
 
 void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, const PinholeCamera& pinhole,
                 const RenderOptions& options, const PixelRect& rect, Frame& frame, TileCounters& counters) {
-    constexpr int kPacket = EmbreeVolumeScene::kPacket;
+    constexpr int kPacket = kMaxTracePacket;
+    const int packet_w = scene ? kEmbreePacketW : kDirectPacketW;
+    const int packet_h = scene ? kEmbreePacketH : kDirectPacketH;
     const bool want_normal = options.want_colour || options.want_normal;
     const bool packets = options.traversal == Traversal::packets;
     const std::span<const ClipPlane> clip_planes = options.clip_planes;
@@ -89,11 +94,11 @@ void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, cons
     Ray rays[kPacket];
     TraceHit traced[kPacket];
     size_t pixel[kPacket];
-    for (int y0 = rect.y0; y0 < rect.y1; y0 += kPacketH)
-        for (int x0 = rect.x0; x0 < rect.x1; x0 += kPacketW) {
+    for (int y0 = rect.y0; y0 < rect.y1; y0 += packet_h)
+        for (int x0 = rect.x0; x0 < rect.x1; x0 += packet_w) {
             int count = 0;
-            for (int py = y0; py < std::min(y0 + kPacketH, rect.y1); ++py)
-                for (int px = x0; px < std::min(x0 + kPacketW, rect.x1); ++px) {
+            for (int py = y0; py < std::min(y0 + packet_h, rect.y1); ++py)
+                for (int px = x0; px < std::min(x0 + packet_w, rect.x1); ++px) {
                     rays[count] = pinhole.ray(px, py);
                     if (!clip_planes.empty()) clip_ray(clip_planes, rays[count]);
                     pixel[count++] = size_t(py) * W + size_t(px);

@@ -4,7 +4,7 @@
 // -mavx2 -mfma -ffp-contract=off) are the same source (kernel_impl.h) in different ISA
 // namespaces (util/isa.h). FMA contraction is off, so both do the same IEEE operations in the
 // same order: frames are bit-identical across ISAs (tests/render/packet_test.cpp). The renderer only
-// sees function pointers, called once per packet of up to 8 rays, never per cell.
+// sees function pointers, called once per packet of up to kMaxTracePacket rays, never per cell.
 #pragma once
 
 #include <memory>
@@ -18,11 +18,15 @@
 
 namespace octiso {
 
+/// The most rays one trace_packet call takes: the renderer's direct packets of 4x4 pixels
+/// (renderer.cpp; Embree's rtcIntersect8 hands over 8).
+inline constexpr int kMaxTracePacket = 16;
+
 struct TracerKernel {
     std::shared_ptr<const void> tracer;                 ///< owns the typed tracer `user` points at
     const void* user = nullptr;
     EmbreeVolumeScene::TraceFn trace = nullptr;               ///< one ray
-    EmbreeVolumeScene::TracePacketFn trace_packet = nullptr;  ///< up to 8 rays
+    EmbreeVolumeScene::TracePacketFn trace_packet = nullptr;  ///< up to kMaxTracePacket rays
     /// Level of detail for the next frames (lod.h); between frames only.
     void (*set_lod)(const void* user, const LodCut& cut) = nullptr;
     Isa isa = Isa::baseline;

@@ -102,8 +102,13 @@ public:
         return w.hit;
     }
 
-    /// The most rays one trace_packet() call takes (one rtcIntersect8 packet, 4x2 pixels).
-    static constexpr int kMaxPacket = 8;
+    /// The most rays one trace_packet() call takes: the renderer's 4x4 pixels (kMaxTracePacket,
+    /// tracer_kernel.h). 16 lanes share each node load, cull, cap parent and corner lattice among
+    /// twice the rays of 8 (4x2, one rtcIntersect8 packet): 0.92-0.95 x the frame time at 1
+    /// thread, 0.86-1.00 x at 2 (min of 7 pairs; build_ab_packet16_rerun.json,
+    /// build_ab_packet16_2threads.json), 0.87-0.92 x in the portable kernel; 32 lanes (8x4)
+    /// gained nothing more (0.98-1.04 x against 16, 5 pairs, no JSON).
+    static constexpr int kMaxPacket = 16;
     /// A packet keeps traversing a subtree together while at least this many of its lanes enter
     /// it; fewer lanes continue as single rays. Measured by `octiso-bench packets` (BENCHMARKS.md,
     /// packet section): since the one-pass child cull, primary rays take 0.97-0.98 x the frame
@@ -113,8 +118,11 @@ public:
     /// Lanes sharing their direction signs that start a packet at the root; fewer start as single
     /// rays. Apart from the descent's threshold: a group of 2 or 3 random rays with the same signs
     /// rarely shares a node, and incoherent rays through the packet entry lost 5-10 % against
-    /// single rays when 2 such lanes started a packet (BENCHMARKS.md, packet section).
+    /// single rays when 2 such lanes started a packet (BENCHMARKS.md, packet section). A packet of
+    /// more than 8 rays needs half of them: 4 of 16 random rays share their signs often enough that
+    /// incoherent rays in groups of 16 lost 3-6 % (plume, mixing 256^3) with a plain 4.
     static constexpr int kMinStartLanes = 4;
+    static int min_start_lanes(int count) { return std::max(kMinStartLanes, count / 2); }
     /// For the benchmark's A/B of the threshold and for tests that force one path; not thread-safe
     /// against a frame in flight.
     void set_min_packet_lanes(int lanes) { min_packet_lanes_ = std::max(1, lanes); }
@@ -163,7 +171,7 @@ public:
         for (int flip = 0; flip < 8; ++flip) {
             const unsigned lanes = by_flip[flip];
             if (!lanes) continue;
-            if (std::popcount(lanes) < std::max(kMinStartLanes, min_packet_lanes_)) {
+            if (std::popcount(lanes) < std::max(min_start_lanes(count), min_packet_lanes_)) {
                 for (unsigned m = lanes; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
                     node(p.lane[k], 0, 0, Coord{}, p.t0[k], p.t1[k]);
