@@ -56,26 +56,30 @@ template <typename T> void check_type(Pattern pattern) {
     const std::vector<Ray> rays = test_rays(dims, 11);
     for (int iso_count : {1, 2}) {
         const OctreeTracer<T, Neubauer> single(data.view(), Placement{}, isos, iso_count, Neubauer{});
-        for (int lanes : {1, 2, OctreeTracer<T, Neubauer>::kDefaultMinPacketLanes, 9}) {
-            OctreeTracer<T, Neubauer> packed(data.view(), Placement{}, isos, iso_count, Neubauer{});
-            packed.set_min_packet_lanes(lanes);
-            uint64_t hits = 0;
-            for (size_t i0 = 0; i0 < rays.size(); i0 += 8) {
-                const int count = int(std::min<size_t>(8, rays.size() - i0));
-                int valid[8];
-                for (int k = 0; k < 8; ++k) valid[k] = (i0 / 8 + size_t(k)) % 7 == 3 ? 0 : -1;   // some lanes off
-                TraceHit out[8];
-                packed.trace_packet(&rays[i0], count, valid, true, out);
-                for (int k = 0; k < count; ++k) {
-                    const TraceHit expected = valid[k] ? single.trace(rays[i0 + size_t(k)], true) : TraceHit{};
-                    hits += expected.is_hit();
-                    ASSERT_TRUE(same_hit(expected, out[k]))
-                        << scalar_type_name(scalar_type_of<T>()) << " ray " << i0 + size_t(k) << ", threshold " << lanes
-                        << ", " << iso_count << " isovalue(s)";
+        // Embree's 8 rays and the renderer's direct 16 (a packet of 16 starts at the root with
+        // 8 lanes of one direction signs, one of 8 with 4).
+        constexpr int kMax = OctreeTracer<T, Neubauer>::kMaxPacket;
+        for (int size : {8, kMax})
+            for (int lanes : {1, 2, OctreeTracer<T, Neubauer>::kDefaultMinPacketLanes, 9}) {
+                OctreeTracer<T, Neubauer> packed(data.view(), Placement{}, isos, iso_count, Neubauer{});
+                packed.set_min_packet_lanes(lanes);
+                uint64_t hits = 0;
+                for (size_t i0 = 0; i0 < rays.size(); i0 += size_t(size)) {
+                    const int count = int(std::min<size_t>(size_t(size), rays.size() - i0));
+                    int valid[kMax];
+                    for (int k = 0; k < kMax; ++k) valid[k] = (i0 / 8 + size_t(k)) % 7 == 3 ? 0 : -1;   // some lanes off
+                    TraceHit out[kMax];
+                    packed.trace_packet(&rays[i0], count, valid, true, out);
+                    for (int k = 0; k < count; ++k) {
+                        const TraceHit expected = valid[k] ? single.trace(rays[i0 + size_t(k)], true) : TraceHit{};
+                        hits += expected.is_hit();
+                        ASSERT_TRUE(same_hit(expected, out[k]))
+                            << scalar_type_name(scalar_type_of<T>()) << " ray " << i0 + size_t(k) << ", packets of " << size
+                            << ", threshold " << lanes << ", " << iso_count << " isovalue(s)";
+                    }
                 }
+                EXPECT_GT(hits, 10u) << "the data must give the packets something to hit";
             }
-            EXPECT_GT(hits, 10u) << "the data must give the packets something to hit";
-        }
     }
 }
 
