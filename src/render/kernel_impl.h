@@ -20,7 +20,6 @@ template <typename T> TracerKernel build_tracer_kernel(const Octree<T>& tree, co
         // so the default kernel carries none of its tests (traverse.h, kOwned).
         const auto build = [&](auto owned) {
             using Tracer = OctreeTracer<T, std::decay_t<decltype(finder)>, OctreeCornerSource, NoRecorder, decltype(owned)::value>;
-            static_assert(Tracer::kMaxPacket == kMaxTracePacket);
             auto tracer = std::make_shared<Tracer>(tree, placement, options.isovalues.data(), int(options.isovalues.size()),
                                                    finder);
             if (options.packet_min_lanes > 0) tracer->set_min_packet_lanes(options.packet_min_lanes);

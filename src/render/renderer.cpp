@@ -75,7 +75,7 @@ namespace {
 /// Pixels of `rect` into `frame`, one packet per kernel or Embree call: blocks of pixels, whose
 /// rays stay closer together than a row's (more lanes share each node and cap; BENCHMARKS.md,
 /// packets: 4x2 against 8x1). Through Embree 4x2 (one rtcIntersect8 packet); called directly
-/// 4x4 (kMaxTracePacket, tracer_kernel.h: the tracer's per-packet work shared by twice the rays).
+/// 4x4 (kMaxTracePacket, packet_size.h: the tracer's per-packet work shared by twice the rays).
 constexpr int kEmbreePacketW = 4, kEmbreePacketH = 2;
 static_assert(kEmbreePacketW * kEmbreePacketH == EmbreeVolumeScene::kPacket);
 constexpr int kDirectPacketW = 4, kDirectPacketH = 4;

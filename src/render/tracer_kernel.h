@@ -14,13 +14,10 @@
 #include "octiso/render.h"
 #include "octiso/volume.h"
 #include "render/lod.h"
+#include "render/packet_size.h"
 #include "scene/embree_scene.h"
 
 namespace octiso {
-
-/// The most rays one trace_packet call takes: the renderer's direct packets of 4x4 pixels
-/// (renderer.cpp; Embree's rtcIntersect8 hands over 8).
-inline constexpr int kMaxTracePacket = 16;
 
 struct TracerKernel {
     std::shared_ptr<const void> tracer;                 ///< owns the typed tracer `user` points at

@@ -35,6 +35,7 @@
 #include "render/cell_hit.h"
 #include "render/live_children.h"
 #include "render/lod.h"
+#include "render/packet_size.h"
 #include "math/ray.h"
 #include "render/roots.h"
 #include "util/check.h"
@@ -102,13 +103,8 @@ public:
         return w.hit;
     }
 
-    /// The most rays one trace_packet() call takes: the renderer's 4x4 pixels (kMaxTracePacket,
-    /// tracer_kernel.h). 16 lanes share each node load, cull, cap parent and corner lattice among
-    /// twice the rays of 8 (4x2, one rtcIntersect8 packet): 0.92-0.95 x the frame time at 1
-    /// thread, 0.86-1.00 x at 2 (min of 7 pairs; build_ab_packet16_rerun.json,
-    /// build_ab_packet16_2threads.json), 0.87-0.92 x in the portable kernel; 32 lanes (8x4)
-    /// gained nothing more (0.98-1.04 x against 16, 5 pairs, no JSON).
-    static constexpr int kMaxPacket = 16;
+    /// The most rays one trace_packet() call takes (packet_size.h).
+    static constexpr int kMaxPacket = kMaxTracePacket;
     /// A packet keeps traversing a subtree together while at least this many of its lanes enter
     /// it; fewer lanes continue as single rays. Measured by `octiso-bench packets` (BENCHMARKS.md,
     /// packet section): since the one-pass child cull, primary rays take 0.97-0.98 x the frame

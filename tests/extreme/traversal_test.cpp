@@ -166,26 +166,26 @@ Result run_rays(const DenseVolume<T>& v, const Octree<T>& tree, double iso, cons
     // single-ray hit bit for bit.
     constexpr int kMax = OctreeTracer<T, Exact>::kMaxPacket;
     for (int size : {8, kMax})
-    for (int lanes : {1, OctreeTracer<T, Exact>::kDefaultMinPacketLanes}) {
-        OctreeTracer<T, Exact> packed(tree, placement, &iso, 1, Exact{});
-        packed.set_min_packet_lanes(lanes);
-        for (size_t i0 = 0; i0 < rays.size(); i0 += size_t(size)) {
-            const int count = int(std::min<size_t>(size_t(size), rays.size() - i0));
-            Ray batch[kMax];
-            TraceHit hits[kMax];
-            for (int k = 0; k < count; ++k) batch[k] = rays[i0 + size_t(k)].ray;
-            packed.trace_packet(batch, count, nullptr, true, hits);
-            for (int k = 0; k < count; ++k) {
-                const TraceHit single = tracer.trace(batch[k], true);
-                if (!(single.iso_index == hits[k].iso_index && std::memcmp(&single.t, &hits[k].t, sizeof(double)) == 0 &&
-                      single.normal == hits[k].normal)) {
-                    ADD_FAILURE() << "packet lane " << k << " (packets of " << size << ", threshold " << lanes
-                                  << ") differs from the single ray: " << describe(batch[k]);
-                    return res;
+        for (int lanes : {1, OctreeTracer<T, Exact>::kDefaultMinPacketLanes}) {
+            OctreeTracer<T, Exact> packed(tree, placement, &iso, 1, Exact{});
+            packed.set_min_packet_lanes(lanes);
+            for (size_t i0 = 0; i0 < rays.size(); i0 += size_t(size)) {
+                const int count = int(std::min<size_t>(size_t(size), rays.size() - i0));
+                Ray batch[kMax];
+                TraceHit hits[kMax];
+                for (int k = 0; k < count; ++k) batch[k] = rays[i0 + size_t(k)].ray;
+                packed.trace_packet(batch, count, nullptr, true, hits);
+                for (int k = 0; k < count; ++k) {
+                    const TraceHit single = tracer.trace(batch[k], true);
+                    if (!(single.iso_index == hits[k].iso_index && std::memcmp(&single.t, &hits[k].t, sizeof(double)) == 0 &&
+                          single.normal == hits[k].normal)) {
+                        ADD_FAILURE() << "packet lane " << k << " (packets of " << size << ", threshold " << lanes
+                                      << ") differs from the single ray: " << describe(batch[k]);
+                        return res;
+                    }
                 }
             }
         }
-    }
     return res;
 }
 
