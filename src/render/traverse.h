@@ -544,6 +544,8 @@ private:
     /// pieces and corners (the cap walk's pieces are the DDA's, walk_cap_cells), so the same
     /// hits bit for bit; the leaf's one inner cell, whose corners all equal its value, is culled
     /// by its corner range instead of skipped. The default tracer only, as packet caps.
+    /// 0.96-0.97 x the frame time on ch2better and ch2 @25.5 and aal @0.5, where 4-190 % as many
+    /// such leaves as caps sit under the cap parents (build_ab_leaf_caps_apart.json).
     static constexpr bool kLeafCaps = !kOwned && kOwnCorners && !Recorder::kOn;
     /// A cap whose 8 voxels all read `v` (kLeafCaps): deltas of zero from the base v.
     static CapRef<T> constant_cap(T v) {
@@ -557,7 +559,8 @@ private:
 
     /// kLeafCaps for one ray (node()) and for the lanes `active` of a packet (packet_node; returns
     /// the lanes that did not hit), apart from the caps' path so that it stays as it was: with the
-    /// leaf folded into the cap branch, frames without such leaves took 1.02-1.05 x as long.
+    /// leaf folded into the cap branch, files with few such leaves read 1.01-1.06 x the frame time
+    /// at the minimum (build_ab_leaf_caps_folded*.json; BENCHMARKS.md, packets, seventh session).
     [[gnu::noinline]] bool leaf_cap(Walk& w, CapParent& parent, int c, T value, const Coord& co, double t0, double t1) const {
         CapBlocks blocks(parent, c);
         return cap(w, w.trace, constant_cap(value), co, t0, t1, blocks);
