@@ -503,7 +503,7 @@ private:
             }
             if (n.is_scalar_leaf(int(c))) {
                 if (kLeafCaps && d == tree_.dmax() - 2) {
-                    hit = entered & ~packet_leaf_cap(p, parent, int(c), n.scalar[c], co, entered, flip, c0, c1);
+                    hit = packet_leaf_cap(p, parent, int(c), n.scalar[c], co, entered, flip, c0, c1);
                 } else {
                     for (unsigned m = entered; m; m &= m - 1) {
                         const int k = std::countr_zero(m);
@@ -512,16 +512,7 @@ private:
                 }
             } else if (d == tree_.dmax() - 2) {
                 CapBlocks blocks(parent, int(c));   // located once for every lane that crosses this cap
-                const CapRef<T> ci = tree_.cap_at(first, n, int(c));
-                if (kPacketCaps && std::popcount(entered) >= kMinCapPacketLanes) {
-                    hit = entered & ~packet_cap(p, ci, co, entered, flip, c0, c1, blocks);
-                    active &= ~hit;
-                    continue;
-                }
-                for (unsigned m = entered; m; m &= m - 1) {
-                    const int k = std::countr_zero(m);
-                    if (cap(p.lane[k], p.trace, ci, co, c0[k], c1[k], blocks)) hit |= 1u << k;
-                }
+                hit = cap_lanes(p, tree_.cap_at(first, n, int(c)), co, entered, flip, c0, c1, blocks);
             } else if (std::popcount(entered) < min_packet_lanes_) {
                 for (unsigned m = entered; m; m &= m - 1) {
                     const int k = std::countr_zero(m);
@@ -537,6 +528,32 @@ private:
         return active;
     }
 
+    /// The cells of a cap as a packet: the default tracer only (the sort-last one's owned-cell and
+    /// ghost tests and the recorder's calls stay in cap(), lane by lane).
+    static constexpr bool kPacketCaps = !kOwned && kOwnCorners && !Recorder::kOn;
+    /// Lanes in a cap from which its cells are walked as a packet (packet_cap); fewer walk alone.
+    /// Worth it only where nearly the whole packet crosses the cap, as close up: from 5 lanes,
+    /// 0.85-1.00 x the frame time at --zoom 3 and 0.91 x on plume 64^3 (8 pixels a voxel), the
+    /// whole-view real scans and 256^3 fields within the noise, 0.98-1.04 x at the minimum
+    /// (build_ab_packet_cap_cells*.json); from 2 lanes the whole views gained 1-4 % but plume 64^3
+    /// lost 6 % (the split and the enter of all 8 cells for 2-3 lanes cost more than the walks).
+    static constexpr int kMinCapPacketLanes = 5;
+
+    /// The lanes of `active` that hit in the cap `ref` at `co` (its lattice `blocks`), each on its
+    /// piece [t0[k], t1[k]): walked as a packet (packet_cap) from kMinCapPacketLanes lanes, else
+    /// lane by lane (cap).
+    OCTISO_ALWAYS_INLINE unsigned cap_lanes(Packet& p, const CapRef<T>& ref, const Coord& co, unsigned active, int flip,
+                                            const double* t0, const double* t1, CapBlocks& blocks) const {
+        if (kPacketCaps && std::popcount(active) >= kMinCapPacketLanes)
+            return active & ~packet_cap(p, ref, co, active, flip, t0, t1, blocks);
+        unsigned hit = 0;
+        for (unsigned m = active; m; m &= m - 1) {
+            const int k = std::countr_zero(m);
+            if (cap(p.lane[k], p.trace, ref, co, t0[k], t1[k], blocks)) hit |= 1u << k;
+        }
+        return hit;
+    }
+
     /// A scalar leaf of side 2 (a child of a cap parent) is walked as a cap whose 8 voxels are its
     /// value: its corner lattice (the forward blocks through the cap parent's neighbours, shared
     /// with the caps beside it and between the lanes) and the cap's split walk, in place of the
@@ -546,7 +563,7 @@ private:
     /// by its corner range instead of skipped. The default tracer only, as packet caps.
     /// 0.96-0.97 x the frame time on ch2better and ch2 @25.5 and aal @0.5, where 4-190 % as many
     /// such leaves as caps sit under the cap parents (build_ab_leaf_caps_apart.json).
-    static constexpr bool kLeafCaps = !kOwned && kOwnCorners && !Recorder::kOn;
+    static constexpr bool kLeafCaps = kPacketCaps;
     /// A cap whose 8 voxels all read `v` (kLeafCaps): deltas of zero from the base v.
     static CapRef<T> constant_cap(T v) {
         if constexpr (sizeof(T) == 1) {
@@ -558,7 +575,7 @@ private:
     }
 
     /// kLeafCaps for one ray (node()) and for the lanes `active` of a packet (packet_node; returns
-    /// the lanes that did not hit), apart from the caps' path so that it stays as it was: with the
+    /// the lanes that hit), apart from the caps' path so that it stays as it was: with the
     /// leaf folded into the cap branch, files with few such leaves read 1.01-1.06 x the frame time
     /// at the minimum (build_ab_leaf_caps_folded*.json; BENCHMARKS.md, packets, seventh session).
     [[gnu::noinline]] bool leaf_cap(Walk& w, CapParent& parent, int c, T value, const Coord& co, double t0, double t1) const {
@@ -568,26 +585,8 @@ private:
     [[gnu::noinline]] unsigned packet_leaf_cap(Packet& p, CapParent& parent, int c, T value, const Coord& co, unsigned active,
                                                int flip, const double* t0, const double* t1) const {
         CapBlocks blocks(parent, c);
-        const CapRef<T> ref = constant_cap(value);
-        if (std::popcount(active) >= kMinCapPacketLanes) return packet_cap(p, ref, co, active, flip, t0, t1, blocks);
-        unsigned missed = active;
-        for (unsigned m = active; m; m &= m - 1) {
-            const int k = std::countr_zero(m);
-            if (cap(p.lane[k], p.trace, ref, co, t0[k], t1[k], blocks)) missed &= ~(1u << k);
-        }
-        return missed;
+        return cap_lanes(p, constant_cap(value), co, active, flip, t0, t1, blocks);
     }
-
-    /// The cells of a cap as a packet: the default tracer only (the sort-last one's owned-cell and
-    /// ghost tests and the recorder's calls stay in cap(), lane by lane).
-    static constexpr bool kPacketCaps = !kOwned && kOwnCorners && !Recorder::kOn;
-    /// Lanes in a cap from which its cells are walked as a packet (packet_cap); fewer walk alone.
-    /// Worth it only where nearly the whole packet crosses the cap, as close up: from 5 lanes,
-    /// 0.85-1.00 x the frame time at --zoom 3 and 0.91 x on plume 64^3 (8 pixels a voxel), the
-    /// whole-view real scans and 256^3 fields within the noise, 0.98-1.04 x at the minimum
-    /// (build_ab_packet_cap_cells*.json); from 2 lanes the whole views gained 1-4 % but plume 64^3
-    /// lost 6 % (the split and the enter of all 8 cells for 2-3 lanes cost more than the walks).
-    static constexpr int kMinCapPacketLanes = 5;
 
     /// The lanes of `active` (signs `flip`) through the cap at `co` (ref, its corner lattice
     /// `blocks`), each on its piece [t0[k], t1[k]): the cap's 8 cells are a node's children of
