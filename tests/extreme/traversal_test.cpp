@@ -119,7 +119,8 @@ struct Result {
 
 /// A test ray. Not `strict`: it runs within ~1e-12 of a cell face (a hair off a mid-plane, or a
 /// tiny tilt), where traverse.h snaps cell-local coordinates onto the face; there a disagreement
-/// is accepted when moving the origin by 1e-11 voxel makes the reference agree (ill-conditioned).
+/// is accepted when moving the origin by at most 1e-11 voxel on each axis makes the reference agree
+/// (ill-conditioned; near an edge it is snapped on two axes, so both may have to move).
 struct TestRay {
     Ray ray;
     bool strict = true;
@@ -156,13 +157,14 @@ Result run_rays(const DenseVolume<T>& v, const Octree<T>& tree, double iso, cons
             continue;
         }
         if (!test_ray.strict) {
+            // Every move of at most 1e-11 per axis: a ray near an edge is snapped onto both faces.
             bool moved_agrees = false;
-            for (int a = 0; a < 3 && !moved_agrees; ++a)
-                for (double delta : {-1e-11, 1e-11}) {
-                    Ray moved = ray;
-                    moved.origin[a] += delta;
-                    moved_agrees |= agrees(trace_reference(v.view(), placement, moved, iso));
-                }
+            for (int move = 0; move < 27 && !moved_agrees; ++move) {
+                if (move == 13) continue;   // (0, 0, 0)
+                Ray moved = ray;
+                for (int a = 0, m = move; a < 3; ++a, m /= 3) moved.origin[a] += (m % 3 - 1) * 1e-11;
+                moved_agrees = agrees(trace_reference(v.view(), placement, moved, iso));
+            }
             if (moved_agrees) {
                 ++res.ill_conditioned;
                 continue;
@@ -343,6 +345,11 @@ template <typename T> void check_side_two_leaves(double scale, double shift, con
     ASSERT_GT(caps, 100u) << what;
     run_all(v, 70.3 * scale + shift, (std::string(what) + " iso 70.3").c_str());
     run_all(v, 109.9 * scale + shift, (std::string(what) + " iso 109.9").c_str());
+    // The isovalue equal to the constant blocks' value 50 (a leaf's whole cube on the surface).
+    // Measured: 136 of 2904 axis rays and 14 of 700 grazing rays ill-conditioned (one ulp inside
+    // an edge or a face of a block, snapped onto it, where f == iso, so hit one cell earlier than
+    // the reference; the same without kLeafCaps), 48 of 1908 special rays touch the box at a point.
+    run_all(v, double(T(50 * scale + shift)), (std::string(what) + " iso = a block's value").c_str(), {136, 0}, {0, 48}, {14, 0});
 }
 
 TEST(TraversalRobustness, SideTwoLeavesBesideCapsMatchTheReference) {
@@ -351,9 +358,6 @@ TEST(TraversalRobustness, SideTwoLeavesBesideCapsMatchTheReference) {
     check_side_two_leaves<uint8_t>(1, 0, "u8 blocks");
     check_side_two_leaves<int16_t>(100, -7000, "i16 blocks");
     check_side_two_leaves<float>(0.37, -11.5, "f32 blocks");
-    // Not here: an isovalue equal to a block's value (u8 50). There 8 of 2904 axis rays, one ulp
-    // inside a cell edge, hit a cell earlier than the reference (snapped onto the face, where
-    // f == iso), with or without kLeafCaps alike (the counts and the first ray the same).
 }
 
 TEST(TraversalRobustness, ConstantVolumeEqualToIsoIsHitWhereTheRayEnters) {
