@@ -1,6 +1,9 @@
 // Image files through OpenImageIO (CONVENTIONS 2): the format follows the extension; colour is
 // 8-bit sRGB unless the format is floating point; the depth AOV is one float channel named Z; the
 // normal AOV three float channels R,G,B. Every write goes to a temporary name renamed on success.
+// OpenImageIO is loaded on the first call of any function here (the module liboctiso_images.so,
+// beside the tools in the build tree, in lib/octiso when installed; $OCTISO_IMAGE_MODULE names
+// another); if it cannot be, the call throws Error(ErrorKind::Other) naming the module.
 #pragma once
 
 #include <string>

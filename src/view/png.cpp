@@ -1,11 +1,10 @@
-// encode_png over OpenImageIO's PNG writer with an in-memory I/O proxy (as src/io/image_io.cpp).
+// encode_png through the image codec (src/io/image_codec.h: OpenImageIO's PNG writer with an
+// in-memory I/O proxy, in the module loaded on the first image), as src/io/image_io.cpp writes.
 #include "view/png.h"
 
 #include <vector>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
+#include "io/image_codec_loader.h"
 #include "octiso/error.h"
 
 namespace octiso::view {
@@ -13,15 +12,15 @@ namespace octiso::view {
 std::string encode_png(const Frame& frame) {
     if (frame.width <= 0 || frame.height <= 0 || frame.rgb.size() != size_t(frame.width) * size_t(frame.height) * 3)
         throw Error("frame", "no colour image to encode", ErrorKind::Other);
-    auto out = OIIO::ImageOutput::create("frame.png");
-    if (!out || !out->supports("ioproxy")) throw Error("frame", "OpenImageIO has no PNG writer with I/O proxies", ErrorKind::Other);
-    OIIO::ImageSpec spec(frame.width, frame.height, 3, OIIO::TypeDesc::UINT8);
-    spec.attribute("png:compressionLevel", 1);
+    const std::string name = "frame.png";
+    const std::vector<std::string> channels{"R", "G", "B"};
+    using image_codec::Pixel;
+    const image_codec::EncodeRequest request{&name, frame.width, frame.height, 3, Pixel::u8, frame.rgb.data(), &channels, Pixel::u8, 1};
     std::vector<unsigned char> bytes;
-    OIIO::Filesystem::IOVecOutput memory(bytes);
-    if (!out->set_ioproxy(&memory) || !out->open("frame.png", spec) ||
-        !out->write_image(OIIO::TypeDesc::UINT8, frame.rgb.data()) || !out->close())
-        throw Error("frame", "PNG encoding failed: " + out->geterror(), ErrorKind::Other);
+    bool in_memory = false;
+    const image_codec::Failure f = image_codec::codec().encode(request, bytes, in_memory);
+    if (f.failed()) throw Error("frame", "PNG encoding failed: " + f.message, ErrorKind::Other);
+    if (!in_memory) throw Error("frame", "OpenImageIO has no PNG writer with I/O proxies", ErrorKind::Other);
     return std::string(bytes.begin(), bytes.end());
 }
 

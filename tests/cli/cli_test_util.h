@@ -22,11 +22,13 @@ struct ToolRun {
     long err_lines() const { return long(std::count(err.begin(), err.end(), '\n')); }
 };
 
-inline ToolRun run_tool(const std::string& tool, const std::string& args) {
+/// Runs a built tool with `args` (shell words); `env` (e.g. "NAME=value") is set for it alone.
+inline ToolRun run_tool(const std::string& tool, const std::string& args, const std::string& env = "") {
     ScratchDir err_dir("octiso_cli_err");
     const std::string err_file = err_dir.file("stderr");
     ToolRun r;
-    r.status = run_shell("'" + std::string(OCTISO_TOOLS_DIR) + "/" + tool + "' " + args + " 2>'" + err_file + "'", &r.out);
+    const std::string prefix = env.empty() ? "" : "env " + env + " ";
+    r.status = run_shell(prefix + "'" + std::string(OCTISO_TOOLS_DIR) + "/" + tool + "' " + args + " 2>'" + err_file + "'", &r.out);
     run_shell("cat '" + err_file + "'", &r.err);
     return r;
 }

@@ -27,6 +27,16 @@ foreach(tool octiso-convert octiso-info octiso-render)
   endif()
 endforeach()
 
+# 2b. The installed renderer writes an image: OpenImageIO comes from the module the install put
+#     under lib/octiso (found through the tool's RUNPATH, $ORIGIN/../lib/octiso), not the build tree.
+execute_process(COMMAND ${prefix}/bin/octiso-convert --synthetic plume:24 -o ${WORK_DIR}/plume.oct
+                OUTPUT_QUIET COMMAND_ERROR_IS_FATAL ANY)
+execute_process(COMMAND ${prefix}/bin/octiso-render ${WORK_DIR}/plume.oct --iso 40.5 --size 32x32 -o ${WORK_DIR}/tool.png
+                OUTPUT_QUIET ERROR_QUIET COMMAND_ERROR_IS_FATAL ANY)
+if(NOT EXISTS ${WORK_DIR}/tool.png)
+  message(FATAL_ERROR "the installed octiso-render wrote no ${WORK_DIR}/tool.png")
+endif()
+
 # 3. Configure and build the consumer against the prefix only (no package registry, no source tree).
 set(launcher)
 if(CXX_COMPILER_LAUNCHER)

@@ -1,0 +1,75 @@
+// OpenImageIO lives in liboctiso_images.so, loaded on the first image (src/io/image_codec.h):
+// nothing octiso builds may depend on it at start-up, the tools still write images through it, and
+// a tool that cannot load it says so in one line, writes nothing and exits 1 (not bad input).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cli/cli_test_util.h"
+
+namespace octiso::test {
+namespace {
+
+const std::string kTools = OCTISO_TOOLS_DIR;
+
+/// Every executable octiso builds beside the tests, and this test binary.
+std::vector<std::string> built_programs() {
+    std::vector<std::string> out{"/proc/self/exe"};
+    for (const char* tool : {"octiso-convert", "octiso-info", "octiso-render", "octiso-view", "octiso-bench", "octiso-probe"})
+        if (std::filesystem::exists(kTools + "/" + tool)) out.push_back(kTools + "/" + tool);
+    return out;
+}
+
+TEST(ImageModule, NoProgramLoadsOpenImageIOAtStartUp) {
+    const std::vector<std::string> programs = built_programs();
+    ASSERT_GE(programs.size(), 4u) << "convert, info and render must be built next to the tests";
+    for (const std::string& p : programs) {
+        std::string deps;
+        ASSERT_EQ(run_shell("ldd '" + (p == "/proc/self/exe" ? std::filesystem::read_symlink(p).string() : p) + "'", &deps), 0) << p;
+        EXPECT_EQ(deps.find("libOpenImageIO"), std::string::npos) << p << " depends on OpenImageIO:\n" << deps;
+        EXPECT_NE(deps.find("libc.so"), std::string::npos) << "ldd listed nothing for " << p;
+    }
+    // The module does, and sits where the build-tree tools look for it.
+    std::string deps;
+    ASSERT_EQ(run_shell("ldd '" + kTools + "/liboctiso_images.so'", &deps), 0);
+    EXPECT_NE(deps.find("libOpenImageIO"), std::string::npos) << deps;
+}
+
+class ImageModuleCli : public ::testing::Test {
+protected:
+    void SetUp() override {
+        oct_ = dir_.file("plume.oct");
+        ASSERT_EQ(run_tool("octiso-convert", "--synthetic plume:24 -o '" + oct_ + "' >/dev/null").status, 0);
+    }
+    ScratchDir dir_{"octiso_image_module"};
+    std::string oct_;
+};
+
+TEST_F(ImageModuleCli, RenderWritesImagesThroughTheModuleItFindsItself) {
+    const std::string png = dir_.file("frame.png"), exr = dir_.file("depth.exr");
+    const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "' --depth '" + exr + "'");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(png));
+    EXPECT_TRUE(std::filesystem::exists(exr));
+    // The same module named explicitly.
+    const ToolRun forced = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "'",
+                                    "OCTISO_IMAGE_MODULE='" + kTools + "/liboctiso_images.so'");
+    EXPECT_EQ(forced.status, 0) << forced.err;
+}
+
+TEST_F(ImageModuleCli, AMissingModuleIsOneLineExitOneAndNoOutput) {
+    const std::string png = dir_.file("frame.png");
+    const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "'",
+                               "OCTISO_IMAGE_MODULE=/nonexistent/liboctiso_images.so");
+    EXPECT_EQ(r.status, 1) << r.err;   // the installation, not the input (ErrorKind::Other)
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+    EXPECT_NE(r.err.find("image module liboctiso_images.so"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("/nonexistent/liboctiso_images.so"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(png));
+    EXPECT_EQ(dir_.entries(), std::vector<std::string>{"plume.oct"}) << "nothing but the input may be left";
+}
+
+}  // namespace
+}  // namespace octiso::test
