@@ -21,7 +21,7 @@
 namespace octiso::image_codec {
 
 /// Bumped whenever ImageCodec or a request changes.
-inline constexpr int kImageCodecAbi = 1;
+inline constexpr int kImageCodecAbi = 2;
 /// The module's file name (dlopen) and the one symbol it exports.
 inline constexpr const char* kModuleFile = "liboctiso_images.so";
 inline constexpr const char* kEntrySymbol = "octiso_image_codec";
@@ -51,8 +51,8 @@ struct Failure {
 struct ImageCodec {
     int abi;
     /// The format OpenImageIO writes for `path` (its format_name(), e.g. "png", "openexr"), or ""
-    /// with `detail` set when no writer takes the extension.
-    std::string (*output_format)(const std::string& path, std::string& detail);
+    /// when no writer takes the extension.
+    std::string (*output_format)(const std::string& path);
     /// Encodes into `bytes` where the format supports I/O proxies (`in_memory` true); else leaves
     /// both alone and returns no failure, and the caller uses write_file.
     Failure (*encode)(const EncodeRequest& request, std::vector<unsigned char>& bytes, bool& in_memory);

@@ -16,13 +16,9 @@ OIIO::TypeDesc type_of(Pixel p) { return p == Pixel::f32 ? OIIO::TypeDesc::FLOAT
 
 Failure other(std::string message) { return Failure{std::move(message), true}; }
 
-std::string output_format(const std::string& path, std::string& detail) {
+std::string output_format(const std::string& path) {
     auto file = OIIO::ImageOutput::create(path);
-    if (!file) {
-        detail = OIIO::geterror();
-        return {};
-    }
-    return file->format_name();
+    return file ? file->format_name() : std::string();
 }
 
 OIIO::ImageSpec spec_of(const EncodeRequest& r) {

@@ -37,15 +37,9 @@ void write_image(const std::string& path, int width, int height, int channels, P
     out.commit();
 }
 
-/// OpenImageIO's writer for `path`, by extension, or "" (detail: why).
-std::string output_format(const std::string& path, std::string& detail) {
-    return image_codec::codec().output_format(path, detail);
-}
-
 /// The float type a file format can hold: float where supported, else its native 8 bits.
 Pixel float_or_native(const std::string& path) {
-    std::string detail;
-    const std::string fmt = output_format(path, detail);
+    const std::string fmt = image_codec::codec().output_format(path);
     if (fmt.empty()) throw Error(path, "no image format for this extension");
     if (fmt == "openexr" || fmt == "tiff" || fmt == "hdr" || fmt == "fits" || fmt == "pfm") return Pixel::f32;
     return Pixel::u8;
@@ -54,16 +48,14 @@ Pixel float_or_native(const std::string& path) {
 }  // namespace
 
 void check_image_path(const std::string& path, const std::string& flag) {
-    std::string detail;
-    if (output_format(path, detail).empty()) throw Error(flag, "'" + path + "': no image format for this extension");
+    if (image_codec::codec().output_format(path).empty()) throw Error(flag, "'" + path + "': no image format for this extension");
 }
 
 bool image_format_holds_floats(const std::string& path) { return float_or_native(path) == Pixel::f32; }
 
 void write_colour_image(const std::string& path, const Frame& frame) {
     if (frame.rgb.empty()) throw Error(path, "the frame has no colour image", ErrorKind::Other);
-    write_image(path, frame.width, frame.height, 3, Pixel::u8, frame.rgb.data(), {"R", "G", "B"},
-                Pixel::u8);
+    write_image(path, frame.width, frame.height, 3, Pixel::u8, frame.rgb.data(), {"R", "G", "B"}, Pixel::u8);
 }
 
 void write_depth_image(const std::string& path, const Frame& frame) {
