@@ -3,7 +3,7 @@
 // thread arena; per frame, one primary ray per pixel through the one tile loop (tile_loop.h),
 // then shading and the AOVs. The traversal is a TracerKernel (tracer_kernel.h) built in
 // set_options for the scalar type, root finder and instruction set; the frame loop calls it once
-// per packet of up to 8 rays, through Embree or directly. What a
+// per packet of up to kMaxTracePacket rays (packet_size.h), through Embree or directly. What a
 // frame does not ask for is not computed: no normals unless colour or the normal AOV is wanted,
 // no shading without colour.
 #include <algorithm>

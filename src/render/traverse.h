@@ -7,6 +7,11 @@
 // splits at exactly the same t at every level and no interval is lost or doubled.
 // Deviation from App. C: the first child is chosen by comparing times, not positions (no
 // position/time rounding mismatch), and +-0 direction components never divide (plane_t gives +inf).
+// Packets (Knoll, Wald, Hansen 2009): lanes with the same direction signs share each node's load,
+// cull and child order; each lane's pieces are node()'s numbers. Lanes of one origin cross the
+// upper levels as a beam, culled by interval bounds on their plane times (Reshetov et al. 2005's
+// interval frustum, here only deciding which subtrees to enter), and get their exact pieces at
+// the hand-off as the node's slab interval, which equals the mid-plane descent's bit for bit.
 // Caps and scalar leaves: a short DDA over their cells. A scalar leaf's inner cells have all 8
 // corners equal to the leaf value, so unless an isovalue equals it only the shell of cells at its
 // +x/+y/+z faces (whose forward corners lie in neighbours) is walked.
@@ -91,6 +96,7 @@ public:
         : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), live_(isovalues, iso_count), finder_(finder),
           corners_(corners), recorder_(recorder) {
         OCTISO_CHECK(tree.dmax() >= 2 && tree.dmax() < kMaxDepth, "dmax ", tree.dmax());
+        beam_depth_ = std::max(0, tree.dmax() - kBeamHandOffLog2Side);   // nodes of side 8 on: packet_node
     }
 
     /// First hit along the world ray; the normal is computed only if `want_normal`.
@@ -119,6 +125,16 @@ public:
     /// incoherent rays in groups of 16 lost 3-6 % (plume, mixing 256^3) with a plain 4.
     static constexpr int kMinStartLanes = 4;
     static int min_start_lanes(int count) { return std::max(kMinStartLanes, count / 2); }
+    /// A packet of primary rays (one origin, no zero direction component) crosses the levels above
+    /// the nodes of side 2^kBeamHandOffLog2Side as one beam (beam_node): a child is culled for the
+    /// whole packet by interval bounds on its lanes' plane times instead of each lane's pieces,
+    /// and the lanes' exact pieces are computed at the hand-off. Exact (the same pieces, the same
+    /// hits bit for bit). Measured with scripts/build_ab.py, orbit of 4, 512^2, 7 pairs, against the
+    /// packets from the root: 0.93-0.98 x the trace time at the minimum on 8 files (real scans,
+    /// 256^3 and 64^3 fields) at 1 thread, 0.79-0.99 x on 5 at 2 threads (build_ab_beam_third.json,
+    /// build_ab_beam_2threads.json); the hand-off at side 4 or 16 instead of 8 within 1 % of it
+    /// (build_ab_beam_side4_vs_8.json, build_ab_beam_side16_vs_8.json).
+    static constexpr int kBeamHandOffLog2Side = 3;
     /// For the benchmark's A/B of the threshold and for tests that force one path; not thread-safe
     /// against a frame in flight.
     void set_min_packet_lanes(int lanes) { min_packet_lanes_ = std::max(1, lanes); }
@@ -172,6 +188,10 @@ public:
                     const int k = std::countr_zero(m);
                     node(p.lane[k], 0, 0, Coord{}, p.t0[k], p.t1[k]);
                 }
+            } else if (beam_depth_ > 0 && !restricted_ && !lod_.on()) {
+                Beam beam;
+                if (beam.bound(p, lanes, flip)) beam_node(p, beam, 0, 0, Coord{}, lanes, flip);
+                else packet_node(p, 0, 0, Coord{}, lanes, flip, p.t0, p.t1);
             } else {
                 packet_node(p, 0, 0, Coord{}, lanes, flip, p.t0, p.t1);
             }
@@ -454,6 +474,21 @@ private:
     };
 #endif
 
+    /// What packet_node and beam_node read of the node (d, index) on entering it, which goes on
+    /// the packet's parent trace: the record, its first child, its children's side and the
+    /// children an isovalue may lie in (LiveChildren).
+    struct PacketNodeAt {
+        const InteriorNode<T>& n;
+        uint64_t first;
+        uint32_t half;
+        unsigned live;
+    };
+    OCTISO_ALWAYS_INLINE PacketNodeAt packet_at(Packet& p, int d, uint32_t index) const {
+        p.trace[d] = index;
+        const InteriorNode<T>& n = tree_.node(d, index);
+        return {n, tree_.first_child(d, index, n), tree_.child_bit(d), live_.of(n)};
+    }
+
     /// Knoll, Wald, Hansen 2009 for primary rays, exact: the lanes in `active` (all with the
     /// direction signs `flip`, bit 4>>a set where dir[a] < 0) traverse node (d, index) together.
     /// Children are visited in the order c = i ^ flip, i = 0..7: a ray with those signs only ever
@@ -468,11 +503,7 @@ private:
                          const double* t0, const double* t1) const {
         OCTISO_DCHECK(d >= 0 && d <= tree_.dmax() - 2, "interior depth ", d, ", dmax ", tree_.dmax());
         OCTISO_DCHECK(index < tree_.node_count(d), "node ", index, " of ", tree_.node_count(d), " at depth ", d);
-        p.trace[d] = index;
-        const InteriorNode<T>& n = tree_.node(d, index);
-        const uint64_t first = tree_.first_child(d, index, n);
-        const uint32_t half = tree_.child_bit(d);
-        const unsigned live = live_.of(n);
+        const auto [n, first, half, live] = packet_at(p, d, index);
         if (!live) return active;
         PacketSplit split;
         split.split(*this, p, o, half, active, t0, t1);
@@ -501,31 +532,43 @@ private:
                     continue;
                 }
             }
-            if (n.is_scalar_leaf(int(c))) {
-                if (kLeafCaps && d == tree_.dmax() - 2) {
-                    hit = packet_leaf_cap(p, parent, int(c), n.scalar[c], co, entered, flip, c0, c1);
-                } else {
-                    for (unsigned m = entered; m; m &= m - 1) {
-                        const int k = std::countr_zero(m);
-                        if (scalar_leaf(p.lane[k], p.trace, d, co, half, n.scalar[c], c0[k], c1[k])) hit |= 1u << k;
-                    }
-                }
-            } else if (d == tree_.dmax() - 2) {
+            if (d == tree_.dmax() - 2 && n.is_scalar_leaf(int(c)) && kLeafCaps) {
+                hit = packet_leaf_cap(p, parent, int(c), n.scalar[c], co, entered, flip, c0, c1);
+            } else if (d == tree_.dmax() - 2 && !n.is_scalar_leaf(int(c))) {
                 CapBlocks blocks(parent, int(c));   // located once for every lane that crosses this cap
                 hit = cap_lanes(p, tree_.cap_at(first, n, int(c)), co, entered, flip, c0, c1, blocks);
-            } else if (std::popcount(entered) < min_packet_lanes_) {
-                for (unsigned m = entered; m; m &= m - 1) {
-                    const int k = std::countr_zero(m);
-                    Walk& w = p.lane[k];
-                    std::copy(p.trace, p.trace + d + 1, w.trace);
-                    if (node(w, d + 1, tree_.child_index_at(first, n, int(c)), co, c0[k], c1[k])) hit |= 1u << k;
-                }
             } else {
-                hit = entered & ~packet_node(p, d + 1, tree_.child_index_at(first, n, int(c)), co, entered, flip, c0, c1);
+                hit = lanes_into_child(p, n, d, first, c, co, half, entered, flip, c0, c1);
             }
             active &= ~hit;
         }
         return active;
+    }
+
+    /// The lanes `entered` of a packet into child c (origin co, side half) of node n at depth d,
+    /// each on its piece [c0[k], c1[k]), where the child is a scalar leaf walked lane by lane or an
+    /// interior node: the subtree as a packet, or lane by lane below min_packet_lanes_ lanes.
+    /// (packet_node's caps and side-2 leaves are its own.) Returns the lanes that hit.
+    OCTISO_ALWAYS_INLINE unsigned lanes_into_child(Packet& p, const InteriorNode<T>& n, int d, uint64_t first, unsigned c,
+                                                   const Coord& co, uint32_t half, unsigned entered, int flip, const double* c0,
+                                                   const double* c1) const {
+        unsigned hit = 0;
+        if (n.is_scalar_leaf(int(c))) {
+            for (unsigned m = entered; m; m &= m - 1) {
+                const int k = std::countr_zero(m);
+                if (scalar_leaf(p.lane[k], p.trace, d, co, half, n.scalar[c], c0[k], c1[k])) hit |= 1u << k;
+            }
+        } else if (std::popcount(entered) < min_packet_lanes_) {
+            for (unsigned m = entered; m; m &= m - 1) {
+                const int k = std::countr_zero(m);
+                Walk& w = p.lane[k];
+                std::copy(p.trace, p.trace + d + 1, w.trace);
+                if (node(w, d + 1, tree_.child_index_at(first, n, int(c)), co, c0[k], c1[k])) hit |= 1u << k;
+            }
+        } else {
+            hit = entered & ~packet_node(p, d + 1, tree_.child_index_at(first, n, int(c)), co, entered, flip, c0, c1);
+        }
+        return hit;
     }
 
     /// The cells of a cap as a packet: the default tracer only (the sort-last one's owned-cell and
@@ -621,6 +664,159 @@ private:
                 if (intersect_cell_in_range(finder_, scene_, w, v, corner, lo, hi, c0[k], c1[k], c1[k] == w.t_exit))
                     active &= ~(1u << k);
             }
+        }
+        return active;
+    }
+
+    /// A packet's lanes as one beam, for the cull of the upper levels (beam_node): their common
+    /// index origin, per axis the least and the largest reciprocal direction, the earliest entry
+    /// into the data box and the latest exit. Only for lanes that share their origin (primary rays
+    /// of a pinhole camera) and have no zero direction component (bound() says whether they do):
+    /// rays from different origins make the bound too loose to cull (incoherent rays through the
+    /// packet entry), and a ray parallel to a plane takes its side by position, not by time.
+    struct Beam {
+        double origin[3], inv_lo[3], inv_hi[3];
+        double t0_lo, t1_hi;
+#if defined(__AVX2__)
+        V4d O, I_lo, I_hi;   ///< the same by axis (x, y, z; the fourth unused)
+        V4l down;            ///< the axes along which the lanes move down (flip)
+#endif
+        bool bound(const Packet& p, unsigned lanes, int flip) {
+            const double inf = std::numeric_limits<double>::infinity();
+            const IndexRay& r0 = p.lane[std::countr_zero(lanes)].ray;
+            t0_lo = inf, t1_hi = -inf;
+            for (int a = 0; a < 3; ++a) origin[a] = r0.origin[a], inv_lo[a] = inf, inv_hi[a] = -inf;
+            for (unsigned m = lanes; m; m &= m - 1) {
+                const int k = std::countr_zero(m);
+                const IndexRay& r = p.lane[k].ray;
+                for (int a = 0; a < 3; ++a) {
+                    if (r.dir[a] == 0 || r.origin[a] != origin[a]) return false;
+                    inv_lo[a] = std::min(inv_lo[a], r.inv_dir[a]), inv_hi[a] = std::max(inv_hi[a], r.inv_dir[a]);
+                }
+                t0_lo = std::min(t0_lo, p.t0[k]), t1_hi = std::max(t1_hi, p.t1[k]);
+            }
+#if defined(__AVX2__)
+            O = V4d{origin[0], origin[1], origin[2], 0.0};
+            I_lo = V4d{inv_lo[0], inv_lo[1], inv_lo[2], 0.0}, I_hi = V4d{inv_hi[0], inv_hi[1], inv_hi[2], 0.0};
+            down = V4l{(flip & 4) ? -1LL : 0LL, (flip & 2) ? -1LL : 0LL, (flip & 1) ? -1LL : 0LL, 0LL};
+#endif
+            return true;
+        }
+        /// False only where no lane's piece of the cube [o, o + side)^3 is non-empty. A lane's piece
+        /// is [max(t0, entry plane times), min(t1, exit plane times)) (beam_pieces), and a plane's
+        /// time, (plane - origin) * inv_dir rounded, is monotone in inv_dir, so over the lanes it
+        /// lies between the products with the least and the largest inv_dir: the bound holds for
+        /// the rounded times themselves, no margin needed.
+        bool may_enter(const Coord& o, uint32_t side, int flip) const {
+#if defined(__AVX2__)
+            (void)flip;
+            // By axis in one register each (x, y, z; the fourth lane is left out of the max and min).
+            const V4d lower{double(o.x), double(o.y), double(o.z), 0.0};
+            const double s = double(side);
+            const V4d upper = lower + V4d{s, s, s, 0.0};
+            const V4d in = (down ? upper : lower) - O, out = (down ? lower : upper) - O;
+            const V4d e0 = in * I_lo, e1 = in * I_hi, x0 = out * I_lo, x1 = out * I_hi;
+            const V4d e = e1 < e0 ? e1 : e0, x = x0 < x1 ? x1 : x0;
+            const double lo = std::max(std::max(t0_lo, e[0]), std::max(e[1], e[2]));
+            const double hi = std::min(std::min(t1_hi, x[0]), std::min(x[1], x[2]));
+            return lo < hi;
+#else
+            const uint32_t lo_face[3] = {o.x, o.y, o.z};
+            double lo = t0_lo, hi = t1_hi;
+            for (int a = 0; a < 3; ++a) {
+                const bool down = (flip >> (2 - a)) & 1;
+                const double lower = double(lo_face[a]), upper = double(lo_face[a] + side);
+                const double in = (down ? upper : lower) - origin[a], out = (down ? lower : upper) - origin[a];
+                lo = std::max(lo, std::min(in * inv_lo[a], in * inv_hi[a]));
+                hi = std::min(hi, std::max(out * inv_lo[a], out * inv_hi[a]));
+            }
+            return lo < hi;
+#endif
+        }
+    };
+
+    /// Each lane's piece of the cube [o, o + side)^3 directly, as the box's slab interval
+    /// [max(t0, entry plane times), min(t1, exit plane times)): the piece the mid-plane descent
+    /// (for_each_child_piece, PacketSplit) reaches it with, bit for bit. Along each axis that
+    /// descent raises the entry by the time of every mid-plane it crosses into the cube's side
+    /// and lowers the exit likewise; the cube's faces are the last such planes, the earlier ones
+    /// have no later (earlier) times (plane_t is monotone in the plane), and a plane crossed
+    /// before t0 or after t1 leaves max/min where they are; a child the descent does not enter
+    /// has an empty slab. For lanes with no zero direction component (Beam::bound). Returns the
+    /// lanes of `active` with a non-empty piece [lo[k], hi[k]).
+    unsigned beam_pieces(const Packet& p, const Coord& o, uint32_t side, unsigned active, int flip, double* lo,
+                         double* hi) const {
+        const uint32_t lo_face[3] = {o.x, o.y, o.z};
+#if defined(__AVX2__)
+        // Four lanes at a time, the same operations: plane_t is (plane - origin) * inv_dir where the
+        // direction is not zero, std::max(a, b) is a < b ? b : a and std::min(a, b) b < a ? b : a.
+        // Lanes outside `active` compute numbers nobody reads.
+        unsigned entered = 0;
+        const double inf_ = std::numeric_limits<double>::infinity();
+        for (int h = 0; h < kMaxPacket / 4; ++h) {
+            if (!((active >> (4 * h)) & 0xFu)) {   // every lane's piece is set: packet_node reads them all
+                store4(lo + 4 * h, V4d{inf_, inf_, inf_, inf_}), store4(hi + 4 * h, -V4d{inf_, inf_, inf_, inf_});
+                continue;
+            }
+            V4d t_in, t_out;
+            load4(t_in, p.t0 + 4 * h), load4(t_out, p.t1 + 4 * h);
+            for (int a = 0; a < 3; ++a) {
+                const bool down = (flip >> (2 - a)) & 1;
+                const double lower = double(lo_face[a]), upper = double(lo_face[a] + side);
+                const double in_ = down ? upper : lower, out_ = down ? lower : upper;
+                V4d O, I;
+                load4(O, p.origin[a] + 4 * h), load4(I, p.inv_dir[a] + 4 * h);
+                const V4d e = (V4d{in_, in_, in_, in_} - O) * I, x = (V4d{out_, out_, out_, out_} - O) * I;
+                t_in = t_in < e ? e : t_in;
+                t_out = x < t_out ? x : t_out;
+            }
+            store4(lo + 4 * h, t_in), store4(hi + 4 * h, t_out);
+            entered |= unsigned(_mm256_movemask_pd(__m256d(t_out > t_in))) << (4 * h);
+        }
+        return entered & active;
+#else
+        std::fill(lo, lo + kMaxPacket, std::numeric_limits<double>::infinity());
+        std::fill(hi, hi + kMaxPacket, -std::numeric_limits<double>::infinity());
+        unsigned entered = 0;
+        for (unsigned m = active; m; m &= m - 1) {
+            const int k = std::countr_zero(m);
+            const IndexRay& r = p.lane[k].ray;
+            double t_in = p.t0[k], t_out = p.t1[k];
+            for (int a = 0; a < 3; ++a) {
+                const bool down = (flip >> (2 - a)) & 1;
+                const double lower = double(lo_face[a]), upper = double(lo_face[a] + side);
+                t_in = std::max(t_in, r.plane_t(a, down ? upper : lower));
+                t_out = std::min(t_out, r.plane_t(a, down ? lower : upper));
+            }
+            lo[k] = t_in, hi[k] = t_out;
+            if (t_out > t_in) entered |= 1u << k;
+        }
+        return entered;
+#endif
+    }
+
+    /// The upper levels for a packet, culled by its Beam instead of each lane's pieces: a child is
+    /// visited (in packet_node's order, front to back for every lane) where an isovalue lies in
+    /// its range and Beam::may_enter; at depth beam_depth_ (or at a scalar leaf above it) each
+    /// lane's piece is computed directly (beam_pieces) and the lanes go on as packet_node would
+    /// take them there. A lane's first hit is the one of packet_node: it tests the same cells on
+    /// the same pieces, in its own front-to-back order. Returns the lanes of `active` that did not hit.
+    unsigned beam_node(Packet& p, const Beam& beam, int d, uint32_t index, const Coord& o, unsigned active, int flip) const {
+        const auto [n, first, half, live] = packet_at(p, d, index);
+        if (!live) return active;
+        for (unsigned m = in_visit_order(live, flip); m && active; m &= m - 1) {
+            const unsigned c = unsigned(std::countr_zero(m) ^ flip);
+            if (!LiveChildren<T>::holds(n, live, int(c), scene_.isovalues, scene_.iso_count)) continue;
+            const Coord co = child_origin_of(o, int(c), half);
+            if (!beam.may_enter(co, half, flip)) continue;
+            const bool leaf = n.is_scalar_leaf(int(c));
+            if (!leaf && d + 1 < beam_depth_) {
+                active = beam_node(p, beam, d + 1, tree_.child_index_at(first, n, int(c)), co, active, flip);
+                continue;
+            }
+            alignas(32) double c0[kMaxPacket], c1[kMaxPacket];
+            const unsigned entered = beam_pieces(p, co, half, active, flip, c0, c1);
+            if (entered) active &= ~lanes_into_child(p, n, d, first, c, co, half, entered, flip, c0, c1);
         }
         return active;
     }
@@ -939,6 +1135,7 @@ private:
     const LiveChildren<T> live_;   ///< the per-node cull of all 8 children (1-byte scalars)
     const Finder finder_;
     int min_packet_lanes_ = kDefaultMinPacketLanes;
+    int beam_depth_ = 0;   ///< depth of the beam's hand-off to packet_node (0: no beam)
     mutable LodCut lod_;   ///< set_lod(): per frame, between frames
     static constexpr bool restricted_ = kOwned;
     CellBox owned_;

@@ -163,6 +163,62 @@ TEST(PacketTraversal, CloseUpFramesWhosePacketsShareCapsAreIdentical) {
     }
 }
 
+/// The beam (OctreeTracer::beam_node: packets of rays from one origin cross the upper levels as
+/// one) against single rays in both kernels: packets of 16 rays from origins on mid-planes of
+/// several levels, aimed at node corners and at edge and face points of lattices of 2 to 16
+/// voxels, so that plane times tie with each other, with the box's and with the hand-off node's
+/// faces, hit exactly what each ray hits alone; so do packets whose lanes leave the box, start
+/// inside it or are switched off.
+TEST(PacketTraversal, BeamOfOneOriginEqualsSingleRaysThroughNodeCornersAndFaces) {
+    const Dims dims{70, 66, 73};   // a cube of 128: the beam spans depths 0 to 3
+    std::vector<Isa> isas{Isa::baseline};
+    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    const std::array<double, 3> origins[] = {{64, 32, -16}, {-8, 64, 32}, {96, -12.5, 96}, {32, 16, 80}, {35.25, 33, 36}};
+    for (Pattern pattern : {Pattern::Blocky, Pattern::Random}) {
+        const DenseVolume<uint8_t> v = make_volume<uint8_t>(dims, pattern, 9);
+        const OctreeData<uint8_t> data = build_octree(v.view(), {});
+        RenderOptions o;
+        o.isovalues = pattern == Pattern::Blocky ? std::vector<double>{1.5, 3.5} : std::vector<double>{127.5, 200.5};
+        for (Isa isa : isas) {
+            const TracerKernel kernel = make_tracer_kernel(data.view(), Placement{}, o, isa);
+            uint64_t hits = 0, packets = 0;
+            for (const auto& eye : origins)
+                for (int step : {2, 4, 8, 16})
+                    for (int plane = 0; plane < 3; ++plane)
+                        for (int u0 = -step; u0 < 72; u0 += 4 * step)
+                            for (int v0 = -step; v0 < 72; v0 += 4 * step) {
+                                Ray rays[kMaxTracePacket];
+                                int valid[kMaxTracePacket];
+                                for (int k = 0; k < kMaxTracePacket; ++k) {
+                                    // a 4x4 block of lattice points on the plane through the box's middle
+                                    std::array<double, 3> target{};
+                                    target[size_t(plane)] = 32;
+                                    target[size_t((plane + 1) % 3)] = u0 + step * (k % 4);
+                                    target[size_t((plane + 2) % 3)] = v0 + step * (k / 4);
+                                    std::array<double, 3> d;
+                                    for (int a = 0; a < 3; ++a) d[size_t(a)] = target[size_t(a)] - eye[size_t(a)];
+                                    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                                    for (double& c : d) c /= len;
+                                    rays[k] = Ray{eye, d};
+                                    valid[k] = (packets + uint64_t(k)) % 13 == 5 ? 0 : -1;
+                                }
+                                TraceHit out[kMaxTracePacket];
+                                kernel.trace_packet(kernel.user, rays, kMaxTracePacket, valid, true, out);
+                                ++packets;
+                                for (int k = 0; k < kMaxTracePacket; ++k) {
+                                    const TraceHit expected = valid[k] ? kernel.trace(kernel.user, rays[k], true) : TraceHit{};
+                                    hits += expected.is_hit();
+                                    ASSERT_TRUE(same_hit(expected, out[k]))
+                                        << "isa " << int(isa) << ", pattern " << int(pattern) << ", eye " << eye[0] << ","
+                                        << eye[1] << "," << eye[2] << ", step " << step << ", plane " << plane << ", block "
+                                        << u0 << "," << v0 << ", lane " << k;
+                                }
+                            }
+            EXPECT_GT(hits, packets * 4) << "most packets must reach the surfaces";
+        }
+    }
+}
+
 TEST(PacketTraversal, Avx2KernelRunsWhereTheCpuHasIt) {
     if (!cpu_has_avx2()) {
         OCTISO_SKIP("this CPU has no AVX2/FMA: only the portable kernel can run");
