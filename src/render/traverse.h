@@ -750,7 +750,7 @@ private:
 #if defined(__AVX2__)
         // Four lanes at a time, the same operations: plane_t is (plane - origin) * inv_dir where the
         // direction is not zero, std::max(a, b) is a < b ? b : a and std::min(a, b) b < a ? b : a.
-        // Lanes outside `active` compute numbers nobody reads.
+        // Other lanes of a half get their own rays' numbers, which packet_node reads and masks out.
         unsigned entered = 0;
         const double inf_ = std::numeric_limits<double>::infinity();
         for (int h = 0; h < kMaxPacket / 4; ++h) {
