@@ -96,7 +96,6 @@ public:
         : tree_(tree), scene_(tree.dims(), placement, isovalues, iso_count), live_(isovalues, iso_count), finder_(finder),
           corners_(corners), recorder_(recorder) {
         OCTISO_CHECK(tree.dmax() >= 2 && tree.dmax() < kMaxDepth, "dmax ", tree.dmax());
-        beam_depth_ = std::max(0, tree.dmax() - kBeamHandOffLog2Side);   // nodes of side 8 on: packet_node
     }
 
     /// First hit along the world ray; the normal is computed only if `want_normal`.
@@ -135,6 +134,8 @@ public:
     /// build_ab_beam_2threads.json); the hand-off at side 4 or 16 instead of 8 within 1 % of it
     /// (build_ab_beam_side4_vs_8.json, build_ab_beam_side16_vs_8.json).
     static constexpr int kBeamHandOffLog2Side = 3;
+    /// The depth at which the beam hands its lanes to packet_node (nodes of side 8); 0 or less: no beam.
+    int beam_depth() const { return tree_.dmax() - kBeamHandOffLog2Side; }
     /// For the benchmark's A/B of the threshold and for tests that force one path; not thread-safe
     /// against a frame in flight.
     void set_min_packet_lanes(int lanes) { min_packet_lanes_ = std::max(1, lanes); }
@@ -188,13 +189,13 @@ public:
                     const int k = std::countr_zero(m);
                     node(p.lane[k], 0, 0, Coord{}, p.t0[k], p.t1[k]);
                 }
-            } else if (beam_depth_ > 0 && !restricted_ && !lod_.on()) {
-                Beam beam;
-                if (beam.bound(p, lanes, flip)) beam_node(p, beam, 0, 0, Coord{}, lanes, flip);
-                else packet_node(p, 0, 0, Coord{}, lanes, flip, p.t0, p.t1);
-            } else {
-                packet_node(p, 0, 0, Coord{}, lanes, flip, p.t0, p.t1);
+                continue;
             }
+            Beam beam;
+            if (beam_depth() > 0 && !restricted_ && !lod_.on() && beam.bound(p, lanes, flip))
+                beam_node(p, beam, 0, 0, Coord{}, lanes, flip);
+            else
+                packet_node(p, 0, 0, Coord{}, lanes, flip, p.t0, p.t1);
         }
         for (int k = 0; k < count; ++k) hits[k] = p.lane[k].hit;
     }
@@ -797,7 +798,7 @@ private:
 
     /// The upper levels for a packet, culled by its Beam instead of each lane's pieces: a child is
     /// visited (in packet_node's order, front to back for every lane) where an isovalue lies in
-    /// its range and Beam::may_enter; at depth beam_depth_ (or at a scalar leaf above it) each
+    /// its range and Beam::may_enter; at depth beam_depth() (or at a scalar leaf above it) each
     /// lane's piece is computed directly (beam_pieces) and the lanes go on as packet_node would
     /// take them there. A lane's first hit is the one of packet_node: it tests the same cells on
     /// the same pieces, in its own front-to-back order. Returns the lanes of `active` that did not hit.
@@ -810,7 +811,7 @@ private:
             const Coord co = child_origin_of(o, int(c), half);
             if (!beam.may_enter(co, half, flip)) continue;
             const bool leaf = n.is_scalar_leaf(int(c));
-            if (!leaf && d + 1 < beam_depth_) {
+            if (!leaf && d + 1 < beam_depth()) {
                 active = beam_node(p, beam, d + 1, tree_.child_index_at(first, n, int(c)), co, active, flip);
                 continue;
             }
@@ -1135,7 +1136,6 @@ private:
     const LiveChildren<T> live_;   ///< the per-node cull of all 8 children (1-byte scalars)
     const Finder finder_;
     int min_packet_lanes_ = kDefaultMinPacketLanes;
-    int beam_depth_ = 0;   ///< depth of the beam's hand-off to packet_node (0: no beam)
     mutable LodCut lod_;   ///< set_lod(): per frame, between frames
     static constexpr bool restricted_ = kOwned;
     CellBox owned_;
