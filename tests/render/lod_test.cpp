@@ -5,11 +5,13 @@
 //   and normals within the root finder's bar, for packets and single rays, with Embree and without;
 // - close up (the cut allows less than 2 voxels anywhere) the frame is the exact one bit for bit,
 //   and lod 0 is the exact frame;
-// - shadow and AO rays see the primary rays' coarse surface (the look of the decimated array).
+// - shadow and AO rays see the primary rays' coarse surface (the look of the decimated array);
+// - packets (and their beam over the upper levels) stop where single rays stop, bit for bit.
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -203,6 +205,46 @@ TEST(Lod, CloseUpAndLodZeroAreTheExactFrame) {
     const Frame coarse = Renderer(data.view(), Placement{}, o).render(camera);
     EXPECT_FALSE(same_frame(coarse, exact));
     EXPECT_LT(coarse.stats.hits_by_cell_log2[0], coarse.stats.hits);
+}
+
+/// A near eye makes the cut vary over the image, from full resolution to units of 16 and more:
+/// primary packets, which cross the upper levels as one beam (traverse.h, beam_node) and stop
+/// there where the cut says, give every pixel the single rays' depth and normal bit for bit, in
+/// both kernels, on a smooth field and on one of scalar leaves, and stop at every unit from 1 to
+/// 16 (so the beam's own stops, at nodes of side 8 and more, are among them).
+TEST(Lod, PacketsAndTheirBeamStopWhereSingleRaysStop) {
+    std::vector<Isa> isas{Isa::baseline};
+    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    struct Case {
+        Field field;
+        double iso;
+    };
+    for (const Case& k : {Case{Field::MarschnerLobb, 47}, Case{Field::Sierpinski, 60}}) {
+        const DenseVolume<uint8_t> v = make_field<uint8_t>(k.field, {97, 90, 101});
+        const OctreeData<uint8_t> data = build_octree(v.view(), {});
+        Camera camera;
+        camera.eye = {-6, -9, 112}, camera.look = {60, 50, 40}, camera.up = {0, 0, 1};
+        camera.fov_deg = 70, camera.width = 128, camera.height = 96;
+        unsigned stop_units = 0;   // bit u: some hit in a cell of 2^u voxels
+        for (const double f : {2.0, 8.0, 24.0}) {
+            RenderOptions o;
+            o.isovalues = {k.iso};
+            o.want_depth = o.want_normal = true;
+            o.lod = f;
+            o.traversal = Traversal::single;
+            const Frame single = Renderer(data.view(), Placement{}, o).render(camera);
+            ASSERT_GT(single.stats.hits, 0u);
+            for (size_t u = 0; u < single.stats.hits_by_cell_log2.size(); ++u)
+                if (single.stats.hits_by_cell_log2[u]) stop_units |= 1u << u;
+            for (const Isa isa : isas) {
+                o.traversal = Traversal::packets, o.isa = isa;
+                const Frame packets = Renderer(data.view(), Placement{}, o).render(camera);
+                EXPECT_TRUE(same_frame(packets, single)) << "field " << int(k.field) << ", lod " << f << ", isa " << int(isa);
+                EXPECT_EQ(packets.stats.hits_by_cell_log2, single.stats.hits_by_cell_log2);
+            }
+        }
+        EXPECT_EQ(stop_units & 0x1Fu, 0x1Fu) << "hits in cells of 1, 2, 4, 8 and 16 voxels, field " << int(k.field);
+    }
 }
 
 TEST(Lod, BadFactorsAreRefused) {
