@@ -133,8 +133,10 @@ public:
     /// 256^3 and 64^3 fields) at 1 thread, 0.79-0.99 x on 5 at 2 threads (build_ab_beam_third.json,
     /// build_ab_beam_2threads.json); the hand-off at side 4 or 16 instead of 8 within 1 % of it
     /// (build_ab_beam_side4_vs_8.json, build_ab_beam_side16_vs_8.json). Level-of-detail frames
-    /// take the beam too, stopping where the cut stops packet_node: 0.97-1.00 x the trace at F = 1
-    /// on plume and mixing 512^3 and 1024^3 (build_ab_lod_beam.json).
+    /// keep the packets from the root: a beam that stops where the cut stops packet_node was tried
+    /// and gave 0.95-0.96 x the LOD F = 1 trace on plume and mixing 1024^3 (cut at the caps) but
+    /// 1.06 x on mixing 2048^3, the case, where the cut is at units 4 and 8
+    /// (build_ab_lod_beam.json, build_ab_lod_nobeam_vs_beam.json).
     static constexpr int kBeamHandOffLog2Side = 3;
     /// The depth at which the beam hands its lanes to packet_node (nodes of side 8); 0 or less: no beam.
     int beam_depth() const { return tree_.dmax() - kBeamHandOffLog2Side; }
@@ -194,7 +196,7 @@ public:
                 continue;
             }
             Beam beam;
-            if (beam_depth() > 0 && !restricted_ && beam.bound(p, lanes, flip))
+            if (beam_depth() > 0 && !restricted_ && !lod_.on() && beam.bound(p, lanes, flip))
                 beam_node(p, beam, 0, 0, Coord{}, lanes, flip);
             else
                 packet_node(p, 0, 0, Coord{}, lanes, flip, p.t0, p.t1);
@@ -260,7 +262,7 @@ private:
         if constexpr (Recorder::kOn) recorder_.enter_node(d, index, o, 2 * half, t0, t1);
         const unsigned live = live_.of(n);
         if (!live && !Recorder::kOn) return false;   // the recorder still lists the culls
-        CapParent parent(n, first);   // used only at depth dmax-2
+        CapParent parent(n, first);   // its neighbours: the caps' at depth dmax-2, coarse corners' above
         bool hit = false;
         for_each_child_piece(w.ray, o, half, t0, t1, [&](int c, double t_cur, double t_next) {
             const bool culled = !LiveChildren<T>::holds(n, live, c, scene_.isovalues, scene_.iso_count);
@@ -281,7 +283,7 @@ private:
                         coarse_cap_corners(parent, c, co, w.trace, corner);
                         return hit = coarse_whole_cell(w, co, 2, corner, t_cur, t_next);
                     }
-                    return hit = coarse_child(w, w.trace, d, n, c, co, half, unit, t_cur, t_next);
+                    return hit = coarse_child(w, w.trace, d, n, c, co, half, unit, t_cur, t_next, &parent);
                 }
             }
             if (n.is_scalar_leaf(c)) {
@@ -516,7 +518,7 @@ private:
         if (!live) return active;
         PacketSplit split;
         split.split(*this, p, o, half, active, t0, t1);
-        CapParent parent(n, first);   // used only at depth dmax-2
+        CapParent parent(n, first);   // its neighbours: the caps' at depth dmax-2, coarse corners' above
         for (unsigned m = in_visit_order(live, flip); m && active; m &= m - 1) {
             const unsigned c = unsigned(std::countr_zero(m) ^ flip);
             if (!LiveChildren<T>::holds(n, live, int(c), scene_.isovalues, scene_.iso_count)) continue;
@@ -534,7 +536,7 @@ private:
                 if (unit > 1 && (leaf || unit == half)) {
                     hit = d == tree_.dmax() - 2 && inside_data(co, half)
                               ? coarse_cap_lanes(p, parent, int(c), co, entered, c0, c1)
-                              : coarse_lanes(p, n, d, int(c), co, half, unit, entered, c0, c1);
+                              : coarse_lanes(p, parent, n, d, int(c), co, half, unit, entered, c0, c1);
                     active &= ~hit;
                     continue;
                 }
@@ -817,23 +819,13 @@ private:
             const Coord co = child_origin_of(o, int(c), half);
             if (!beam.may_enter(co, half, flip)) continue;
             const bool leaf = n.is_scalar_leaf(int(c));
-            // Level of detail: where packet_node would stop at this child (the cut is the node's,
-            // not the ray's), the beam stops too and each lane traces its coarse child.
-            uint32_t unit = 1;
-            if (lod_.on()) [[unlikely]] unit = lod_.unit(co, half);
-            const bool coarse = unit > 1 && (leaf || unit == half);
-            if (!leaf && !coarse && d + 1 < beam_depth()) {
+            if (!leaf && d + 1 < beam_depth()) {
                 active = beam_node(p, beam, d + 1, tree_.child_index_at(first, n, int(c)), co, active, flip);
                 continue;
             }
             alignas(32) double c0[kMaxPacket], c1[kMaxPacket];
             const unsigned entered = beam_pieces(p, co, half, active, flip, c0, c1);
-            if (!entered) continue;
-            if (coarse) [[unlikely]] {
-                active &= ~coarse_lanes(p, n, d, int(c), co, half, unit, entered, c0, c1);
-                continue;
-            }
-            active &= ~lanes_into_child(p, n, d, first, c, co, half, entered, flip, c0, c1);
+            if (entered) active &= ~lanes_into_child(p, n, d, first, c, co, half, entered, flip, c0, c1);
         }
         return active;
     }
@@ -1055,8 +1047,9 @@ private:
     /// visit of the parent, for all its children and a packet's lanes). coarse_child walked each
     /// ray's one cell by the DDA and found its 8 corners by a descent each: the same corners, and
     /// the DDA's piece of a single cell is the ray's [t0, t1), so the same hits bit for bit.
-    /// With the beam: 0.79-0.80 x the trace at F = 1 on plume and mixing 1024^3 (96 % of hits at
-    /// unit 2 there), 0.93-0.95 x at 512^3, every pixel the same (build_ab_lod_cap_corners.json).
+    /// 0.80-0.84 x the trace at F = 1 on plume and mixing 1024^3 (96 % of the hits at unit 2
+    /// there), every pixel the same (with a beam under LOD since dropped: 0.79-0.80 x, and 0.93-0.95
+    /// x at 512^3; build_ab_lod_cap_corners.json, build_ab_lod_nobeam_vs_beam.json).
     void coarse_cap_corners(CapParent& parent, int c, const Coord& co, const uint32_t* trace, double corner[8]) const {
         for (int k = 0; k < 8; ++k) {
             // Corner k (x = bit 0) is block r (octant bits, x = 4) of the child: the lower corner
@@ -1094,10 +1087,10 @@ private:
     /// as a box of one unit (two builds alternated under load, no JSON: a direction, BENCHMARKS
     /// "Level of detail"). Everything else walks.
     bool coarse_child(RayState& w, const uint32_t* trace, int d, const InteriorNode<T>& n, int c, const Coord& co,
-                      uint32_t side, uint32_t unit, double t0, double t1) const {
+                      uint32_t side, uint32_t unit, double t0, double t1, CapParent* beside = nullptr) const {
         if (!whole_coarse_child(d, co, side, unit)) return coarse_cells(w, trace, d, co, side, unit, n.is_scalar_leaf(c), n.scalar[c], t0, t1);
         double corner[8];
-        coarse_child_corners(trace, d, n, c, co, side, corner);
+        coarse_child_corners(trace, d, n, c, co, side, corner, beside);
         return coarse_whole_cell(w, co, side, corner, t0, t1);
     }
     /// Whether child c of side `side` at co, of a node at depth d above the cap parents, is one
@@ -1105,9 +1098,15 @@ private:
     bool whole_coarse_child(int d, const Coord& co, uint32_t side, uint32_t unit) const {
         return unit == side && d < tree_.dmax() - 2 && inside_data(co, side);
     }
-    /// The corners of such a child: the lattice voxels at its 8 vertices.
+    /// The corners of such a child: the lattice voxels at its 8 vertices. With `beside` (the
+    /// node's forward neighbours at depth d, located at most once per visit of the node, for all
+    /// its children and lanes) a corner beyond the node is the scalar of child c ^ step of entry
+    /// c & step, the lower corner voxel of that child (format 4) or the leaf's value, which is
+    /// what lattice_value descends to; without it, that descent. 0.956-0.967 x the LOD F = 1 trace
+    /// on plume and mixing 2048^3 (96 % and 84 % of the hits at unit 4; min of 7 pairs,
+    /// build_ab_lod_node_neighbours.json; at F = 4 0.87-1.01 x, build_ab_lod_node_neighbours_f4.json).
     void coarse_child_corners(const uint32_t* trace, int d, const InteriorNode<T>& n, int c, const Coord& co, uint32_t side,
-                              double corner[8]) const {
+                              double corner[8], CapParent* beside) const {
         for (int k = 0; k < 8; ++k) {
             // Corner k (x = bit 0) is the lower corner of the sibling one step up on its axes
             // (octant bits: x = 4, y = 2, z = 1) when that sibling is in this node.
@@ -1116,9 +1115,32 @@ private:
                 corner[k] = double(n.scalar[c | step]);
                 continue;
             }
+            if (beside) {
+                const int q = c & step, oct = c ^ step;
+                if (!((beside->ready >> q) & 1u)) locate_neighbour_node(*beside, q, co, d, trace);
+                corner[k] = double((beside->is_leaf >> q) & 1u ? beside->leaf[q] : beside->node[q]->scalar[oct]);
+                continue;
+            }
             const Coord q{co.x + ((k & 1) ? side : 0u), co.y + ((k & 2) ? side : 0u), co.z + ((k & 4) ? side : 0u)};
             corner[k] = double(tree_.lattice_value(co, q, side, d, trace));
         }
+    }
+    /// Locates entry q of `beside` (a CapParent kept for the node at depth d that holds co): the
+    /// depth-d node across the faces that q's bits name, or the scalar leaf above it covering it.
+    [[gnu::noinline]] void locate_neighbour_node(CapParent& beside, int q, const Coord& co, int d, const uint32_t* trace) const {
+        const uint32_t side = 2 * tree_.child_bit(d), mask = ~(side - 1);
+        const Coord dest{(co.x & mask) + ((q & 4) ? side : 0u), (co.y & mask) + ((q & 2) ? side : 0u),
+                         (co.z & mask) + ((q & 1) ? side : 0u)};
+        const auto at = tree_.node_at(co, dest, d, trace, d);
+        if (at.is_leaf) {
+            beside.is_leaf |= 1u << q;
+            beside.leaf[q] = at.value;
+        } else {
+            const InteriorNode<T>& n = tree_.node(d, at.index);
+            beside.node[q] = &n;
+            beside.first[q] = tree_.first_child(d, at.index, n);
+        }
+        beside.ready |= 1u << q;
     }
     /// The whole coarse cell of side `side` at co with `corner` on the ray's piece [t0, t1).
     bool coarse_whole_cell(RayState& w, const Coord& co, uint32_t side, const double corner[8], double t0, double t1) const {
@@ -1133,15 +1155,16 @@ private:
     /// the cap parents), each on its piece [c0[k], c1[k]), where the cut stops there at `unit`: a
     /// whole coarse cell has its corners read once for all the lanes (the same numbers as each
     /// lane's coarse_child), anything else is walked lane by lane. Returns the lanes that hit.
-    /// 0.94-0.97 x the trace at F = 1 on plume and mixing 1024^3 and plume 2048^3 against the
-    /// build before it (min of 7 pairs while a conversion loaded the host; medians 0.92-0.93;
-    /// build_ab_lod_shared_corners.json).
-    unsigned coarse_lanes(Packet& p, const InteriorNode<T>& n, int d, int c, const Coord& co, uint32_t half, uint32_t unit,
-                          unsigned entered, const double* c0, const double* c1) const {
+    /// 0.94-0.97 x the trace at F = 1 on plume and mixing 1024^3 against the build before it (min
+    /// of 7 pairs while a conversion loaded the host; build_ab_lod_shared_corners.json; its plume
+    /// 2048^3 row verified the file's blocks inside the frame, the A/Bs at 2048^3 after it use
+    /// --verify full).
+    unsigned coarse_lanes(Packet& p, CapParent& beside, const InteriorNode<T>& n, int d, int c, const Coord& co, uint32_t half,
+                          uint32_t unit, unsigned entered, const double* c0, const double* c1) const {
         unsigned hit = 0;
         if (whole_coarse_child(d, co, half, unit)) {
             double corner[8];
-            coarse_child_corners(p.trace, d, n, c, co, half, corner);
+            coarse_child_corners(p.trace, d, n, c, co, half, corner, &beside);
             for (unsigned m = entered; m; m &= m - 1) {
                 const int k = std::countr_zero(m);
                 if (coarse_whole_cell(p.lane[k], co, half, corner, c0[k], c1[k])) hit |= 1u << k;
@@ -1150,7 +1173,7 @@ private:
         }
         for (unsigned m = entered; m; m &= m - 1) {
             const int k = std::countr_zero(m);
-            if (coarse_child(p.lane[k], p.trace, d, n, c, co, half, unit, c0[k], c1[k])) hit |= 1u << k;
+            if (coarse_child(p.lane[k], p.trace, d, n, c, co, half, unit, c0[k], c1[k], &beside)) hit |= 1u << k;
         }
         return hit;
     }

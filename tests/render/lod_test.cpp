@@ -6,7 +6,7 @@
 // - close up (the cut allows less than 2 voxels anywhere) the frame is the exact one bit for bit,
 //   and lod 0 is the exact frame;
 // - shadow and AO rays see the primary rays' coarse surface (the look of the decimated array);
-// - packets (and their beam over the upper levels) stop where single rays stop, bit for bit.
+// - packets stop where single rays stop, bit for bit.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -208,11 +208,11 @@ TEST(Lod, CloseUpAndLodZeroAreTheExactFrame) {
 }
 
 /// A near eye makes the cut vary over the image, from full resolution to units of 16 and more:
-/// primary packets, which cross the upper levels as one beam (traverse.h, beam_node) and stop
-/// there where the cut says, give every pixel the single rays' depth and normal bit for bit, in
-/// both kernels, on a smooth field and on one of scalar leaves, and stop at every unit from 1 to
-/// 16 (so the beam's own stops, at nodes of side 8 and more, are among them).
-TEST(Lod, PacketsAndTheirBeamStopWhereSingleRaysStop) {
+/// primary packets, whose lanes stopped at a whole coarse cell or a cap share its corners
+/// (traverse.h, coarse_lanes, coarse_cap_lanes), give every pixel the single rays' depth and
+/// normal bit for bit, in both kernels, on a smooth field and on one of scalar leaves, and stop at
+/// every unit from 1 to 16.
+TEST(Lod, PacketsStopWhereSingleRaysStop) {
     std::vector<Isa> isas{Isa::baseline};
     if (cpu_has_avx2()) isas.push_back(Isa::avx2);
     struct Case {
