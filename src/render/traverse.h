@@ -861,20 +861,24 @@ private:
         return cell[0] > int64_t(dims.x) - 2 || cell[1] > int64_t(dims.y) - 2 || cell[2] > int64_t(dims.z) - 2;
     }
 
-    /// Locates entry q of `parent` (CapParent), the cap parent holding `co`, from its trace.
-    [[gnu::noinline]] void locate_cap_parent(CapParent& parent, int q, const Coord& co, const uint32_t* trace) const {
-        const int parent_depth = tree_.dmax() - 2;
-        const Coord dest{(co.x & ~3u) + ((q & 4) ? 4u : 0u), (co.y & ~3u) + ((q & 2) ? 4u : 0u), (co.z & ~3u) + ((q & 1) ? 4u : 0u)};
-        const auto at = tree_.node_at(co, dest, parent_depth, trace, parent_depth);
+    /// Locates entry q of `beside`, the CapParent kept for the node at depth d that holds `co` (the
+    /// cap parent at dmax-2, or a node whose coarse corners level of detail reads), from its
+    /// trace: the depth-d node across the faces that q's bits name, or the scalar leaf above it
+    /// that covers it.
+    [[gnu::noinline]] void locate_neighbour_node(CapParent& beside, int q, const Coord& co, int d, const uint32_t* trace) const {
+        const uint32_t side = 2 * tree_.child_bit(d), mask = ~(side - 1);
+        const Coord dest{(co.x & mask) + ((q & 4) ? side : 0u), (co.y & mask) + ((q & 2) ? side : 0u),
+                         (co.z & mask) + ((q & 1) ? side : 0u)};
+        const auto at = tree_.node_at(co, dest, d, trace, d);
         if (at.is_leaf) {
-            parent.is_leaf |= 1u << q;
-            parent.leaf[q] = at.value;
+            beside.is_leaf |= 1u << q;
+            beside.leaf[q] = at.value;
         } else {
-            const InteriorNode<T>& n = tree_.node(parent_depth, at.index);
-            parent.node[q] = &n;
-            parent.first[q] = tree_.first_child(parent_depth, at.index, n);
+            const InteriorNode<T>& n = tree_.node(d, at.index);
+            beside.node[q] = &n;
+            beside.first[q] = tree_.first_child(d, at.index, n);
         }
-        parent.ready |= 1u << q;
+        beside.ready |= 1u << q;
     }
 
     /// Puts the lattice voxels of the blocks in `missing` into `blocks` (CapBlocks). Block r of the
@@ -889,7 +893,7 @@ private:
             LeafRef<T> found{T{}, true, ref, 0};
             if (r != 0) {
                 const int q = c & r, oct = c ^ r;
-                if (!((parent.ready >> q) & 1u)) locate_cap_parent(parent, q, co, trace);
+                if (!((parent.ready >> q) & 1u)) locate_neighbour_node(parent, q, co, tree_.dmax() - 2, trace);
                 if ((parent.is_leaf >> q) & 1u) {
                     found = {parent.leaf[q], false, {}, 0};
                 } else {
@@ -1056,7 +1060,7 @@ private:
             // voxel of child c ^ r of parent entry c & r (fill_cap_blocks' mapping).
             const int r = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);
             const int q = c & r, oct = c ^ r;
-            if (!((parent.ready >> q) & 1u)) locate_cap_parent(parent, q, co, trace);
+            if (!((parent.ready >> q) & 1u)) locate_neighbour_node(parent, q, co, tree_.dmax() - 2, trace);
             if ((parent.is_leaf >> q) & 1u) {
                 corner[k] = double(parent.leaf[q]);
                 continue;
@@ -1124,23 +1128,6 @@ private:
             const Coord q{co.x + ((k & 1) ? side : 0u), co.y + ((k & 2) ? side : 0u), co.z + ((k & 4) ? side : 0u)};
             corner[k] = double(tree_.lattice_value(co, q, side, d, trace));
         }
-    }
-    /// Locates entry q of `beside` (a CapParent kept for the node at depth d that holds co): the
-    /// depth-d node across the faces that q's bits name, or the scalar leaf above it covering it.
-    [[gnu::noinline]] void locate_neighbour_node(CapParent& beside, int q, const Coord& co, int d, const uint32_t* trace) const {
-        const uint32_t side = 2 * tree_.child_bit(d), mask = ~(side - 1);
-        const Coord dest{(co.x & mask) + ((q & 4) ? side : 0u), (co.y & mask) + ((q & 2) ? side : 0u),
-                         (co.z & mask) + ((q & 1) ? side : 0u)};
-        const auto at = tree_.node_at(co, dest, d, trace, d);
-        if (at.is_leaf) {
-            beside.is_leaf |= 1u << q;
-            beside.leaf[q] = at.value;
-        } else {
-            const InteriorNode<T>& n = tree_.node(d, at.index);
-            beside.node[q] = &n;
-            beside.first[q] = tree_.first_child(d, at.index, n);
-        }
-        beside.ready |= 1u << q;
     }
     /// The whole coarse cell of side `side` at co with `corner` on the ray's piece [t0, t1).
     bool coarse_whole_cell(RayState& w, const Coord& co, uint32_t side, const double corner[8], double t0, double t1) const {
