@@ -1051,9 +1051,10 @@ private:
     /// visit of the parent, for all its children and a packet's lanes). coarse_child walked each
     /// ray's one cell by the DDA and found its 8 corners by a descent each: the same corners, and
     /// the DDA's piece of a single cell is the ray's [t0, t1), so the same hits bit for bit.
-    /// 0.80-0.84 x the trace at F = 1 on plume and mixing 1024^3 (96 % of the hits at unit 2
-    /// there), every pixel the same (with a beam under LOD since dropped: 0.79-0.80 x, and 0.93-0.95
-    /// x at 512^3; build_ab_lod_cap_corners.json, build_ab_lod_nobeam_vs_beam.json).
+    /// 0.79-0.80 x the trace at F = 1 on plume and mixing 1024^3 (96 % of the hits at unit 2
+    /// there), 0.93-0.95 x at 512^3, every pixel the same (measured with a beam under LOD since
+    /// dropped, build_ab_lod_cap_corners.json; without it, with coarse_lanes, 0.82-0.84 x against
+    /// the build before both, build_ab_lod_final_f1.json).
     void coarse_cap_corners(CapParent& parent, int c, const Coord& co, const uint32_t* trace, double corner[8]) const {
         for (int k = 0; k < 8; ++k) {
             // Corner k (x = bit 0) is block r (octant bits, x = 4) of the child: the lower corner
