@@ -277,14 +277,8 @@ private:
                 // A leaf is walked on the coarsest lattice its distance allows; a stored child
                 // stops only where the whole child is one coarse cell, else it is descended.
                 const uint32_t unit = lod_.unit(co, half);
-                if (unit > 1 && (n.is_scalar_leaf(c) || unit == half)) {
-                    if (d == tree_.dmax() - 2 && inside_data(co, half)) {
-                        double corner[8];
-                        coarse_cap_corners(parent, c, co, w.trace, corner);
-                        return hit = coarse_whole_cell(w, co, 2, corner, t_cur, t_next);
-                    }
-                    return hit = coarse_child(w, w.trace, d, n, c, co, half, unit, t_cur, t_next, &parent);
-                }
+                if (unit > 1 && (n.is_scalar_leaf(c) || unit == half))
+                    return hit = coarse_child(w, w.trace, d, n, c, co, half, unit, t_cur, t_next, parent);
             }
             if (n.is_scalar_leaf(c)) {
                 hit = kLeafCaps && d == tree_.dmax() - 2 ? leaf_cap(w, parent, c, n.scalar[c], co, t_cur, t_next)
@@ -534,9 +528,7 @@ private:
                 const uint32_t unit = lod_.unit(co, half);
                 const bool leaf = n.is_scalar_leaf(int(c));
                 if (unit > 1 && (leaf || unit == half)) {
-                    hit = d == tree_.dmax() - 2 && inside_data(co, half)
-                              ? coarse_cap_lanes(p, parent, int(c), co, entered, c0, c1)
-                              : coarse_lanes(p, parent, n, d, int(c), co, half, unit, entered, c0, c1);
+                    hit = coarse_lanes(p, parent, n, d, int(c), co, half, unit, entered, c0, c1);
                     active &= ~hit;
                     continue;
                 }
@@ -1044,90 +1036,48 @@ private:
         return co.x + side < dims.x && co.y + side < dims.y && co.z + side < dims.z;
     }
 
-    /// Level of detail at unit 2, the cut at the caps: child c of the cap parent `parent` (a cap or
-    /// a scalar leaf of side 2 at `co`, whole inside the data) is one coarse cell, whose corners
-    /// are the voxels at co + 2 (i, j, k): the lower corner voxel of the child and of the 2^3 blocks
-    /// after it, in this parent or across its faces (the neighbours CapParent locates once per
-    /// visit of the parent, for all its children and a packet's lanes). coarse_child walked each
-    /// ray's one cell by the DDA and found its 8 corners by a descent each: the same corners, and
-    /// the DDA's piece of a single cell is the ray's [t0, t1), so the same hits bit for bit.
-    /// 0.79-0.80 x the trace at F = 1 on plume and mixing 1024^3 (96 % of the hits at unit 2
-    /// there), 0.93-0.95 x at 512^3, every pixel the same (measured with a beam under LOD since
-    /// dropped, build_ab_lod_cap_corners.json; without it, with coarse_lanes, 0.82-0.84 x against
-    /// the build before both, build_ab_lod_final_f1.json).
-    void coarse_cap_corners(CapParent& parent, int c, const Coord& co, const uint32_t* trace, double corner[8]) const {
-        for (int k = 0; k < 8; ++k) {
-            // Corner k (x = bit 0) is block r (octant bits, x = 4) of the child: the lower corner
-            // voxel of child c ^ r of parent entry c & r (fill_cap_blocks' mapping).
-            const int r = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);
-            const int q = c & r, oct = c ^ r;
-            if (!((parent.ready >> q) & 1u)) locate_neighbour_node(parent, q, co, tree_.dmax() - 2, trace);
-            if ((parent.is_leaf >> q) & 1u) {
-                corner[k] = double(parent.leaf[q]);
-                continue;
-            }
-            const InteriorNode<T>& n = *parent.node[q];
-            corner[k] = double(n.is_scalar_leaf(oct) ? n.scalar[oct] : tree_.cap_at(parent.first[q], n, oct).voxel(0));
-        }
-    }
-    /// The same for the lanes `entered` of a packet, each on its piece [c0[k], c1[k]): the corners
-    /// read once for all of them. Returns the lanes that hit.
-    unsigned coarse_cap_lanes(Packet& p, CapParent& parent, int c, const Coord& co, unsigned entered, const double* c0,
-                              const double* c1) const {
-        double corner[8];
-        coarse_cap_corners(parent, c, co, p.trace, corner);
-        unsigned hit = 0;
-        for (unsigned m = entered; m; m &= m - 1) {
-            const int k = std::countr_zero(m);
-            if (coarse_whole_cell(p.lane[k], co, 2, corner, c0[k], c1[k])) hit |= 1u << k;
-        }
-        return hit;
-    }
-
     /// Level of detail: child c (origin co, side `side`) of node n at depth d, traced on lattice
     /// `unit` over [t0, t1). A child that is one whole coarse cell inside the data is tested at
-    /// once, its corners the samples its siblings keep (format 4: the voxel at each stored child's
-    /// lower corner, a leaf's value) or lattice reads beyond the node: with the leaf-interior skip
+    /// once, its corners the lower corner voxels of its siblings and of the node's neighbours'
+    /// children (coarse_corners; `beside` holds the node and those neighbours): with the leaf-interior skip
     /// of coarse_cells, 1.07 x / 1.05 x faster frames at F = 2 / 4 on plume 1024^3 than walking it
     /// as a box of one unit (two builds alternated under load, no JSON: a direction, BENCHMARKS
     /// "Level of detail"). Everything else walks.
     bool coarse_child(RayState& w, const uint32_t* trace, int d, const InteriorNode<T>& n, int c, const Coord& co,
-                      uint32_t side, uint32_t unit, double t0, double t1, CapParent* beside = nullptr) const {
-        if (!whole_coarse_child(d, co, side, unit)) return coarse_cells(w, trace, d, co, side, unit, n.is_scalar_leaf(c), n.scalar[c], t0, t1);
+                      uint32_t side, uint32_t unit, double t0, double t1, CapParent& beside) const {
+        if (!whole_coarse_child(co, side, unit)) return coarse_cells(w, trace, d, co, side, unit, n.is_scalar_leaf(c), n.scalar[c], t0, t1);
         double corner[8];
-        coarse_child_corners(trace, d, n, c, co, side, corner, beside);
+        coarse_corners(beside, trace, d, c, co, corner);
         return coarse_whole_cell(w, co, side, corner, t0, t1);
     }
-    /// Whether child c of side `side` at co, of a node at depth d above the cap parents, is one
-    /// whole coarse cell of lattice `unit` inside the data (coarse_child tests it at once).
-    bool whole_coarse_child(int d, const Coord& co, uint32_t side, uint32_t unit) const {
-        return unit == side && d < tree_.dmax() - 2 && inside_data(co, side);
-    }
-    /// The corners of such a child: the lattice voxels at its 8 vertices. With `beside` (the
-    /// node's forward neighbours at depth d, located at most once per visit of the node, for all
-    /// its children and lanes) a corner beyond the node is the scalar of child c ^ step of entry
-    /// c & step, the lower corner voxel of that child (format 4) or the leaf's value, which is
-    /// what lattice_value descends to; without it, that descent. 0.956-0.967 x the LOD F = 1 trace
-    /// on plume and mixing 2048^3 (96 % and 84 % of the hits at unit 4; min of 7 pairs,
-    /// build_ab_lod_node_neighbours.json; at F = 4 0.87-1.01 x, build_ab_lod_node_neighbours_f4.json).
-    void coarse_child_corners(const uint32_t* trace, int d, const InteriorNode<T>& n, int c, const Coord& co, uint32_t side,
-                              double corner[8], CapParent* beside) const {
+    /// Whether a child of side `side` at co is one whole coarse cell of lattice `unit` inside the
+    /// data (coarse_child tests it at once).
+    bool whole_coarse_child(const Coord& co, uint32_t side, uint32_t unit) const { return unit == side && inside_data(co, side); }
+
+    /// The corners of such a child c of the node at depth d, the lattice voxels at its 8 vertices:
+    /// corner k is the lower corner voxel of child c ^ r of entry c & r of `beside` (r the octant
+    /// bits of k; entry 0 is the node itself, the others its forward neighbours at depth d,
+    /// located at most once per visit of the node, for all its children and a packet's lanes).
+    /// That voxel is a stored child's scalar above the cap parents (format 4), a cap's voxel 0 at
+    /// them, a scalar leaf's value anywhere: what a descent by lattice_value returns, bit for bit.
+    /// Against a DDA walk of the one cell with a descent per corner, per lane (the path before):
+    /// a cut at the caps 0.79-0.80 x the LOD F = 1 trace on plume and mixing 1024^3, 0.93-0.95 x
+    /// at 512^3 (build_ab_lod_cap_corners.json); above them, the corners once for a packet's lanes
+    /// 0.94-0.97 x at 1024^3 (build_ab_lod_shared_corners.json) and the neighbours once per node
+    /// 0.956-0.967 x on plume and mixing 2048^3, where 84-96 % of the hits stop at unit 4
+    /// (build_ab_lod_node_neighbours.json); every pixel the same.
+    void coarse_corners(CapParent& beside, const uint32_t* trace, int d, int c, const Coord& co, double corner[8]) const {
+        const bool at_caps = d == tree_.dmax() - 2;
         for (int k = 0; k < 8; ++k) {
-            // Corner k (x = bit 0) is the lower corner of the sibling one step up on its axes
-            // (octant bits: x = 4, y = 2, z = 1) when that sibling is in this node.
-            const int step = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);
-            if ((c & step) == 0) {
-                corner[k] = double(n.scalar[c | step]);
+            const int r = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner k (x = bit 0) as octant bits (x = 4)
+            const int q = c & r, oct = c ^ r;
+            if (!((beside.ready >> q) & 1u)) locate_neighbour_node(beside, q, co, d, trace);
+            if ((beside.is_leaf >> q) & 1u) {
+                corner[k] = double(beside.leaf[q]);
                 continue;
             }
-            if (beside) {
-                const int q = c & step, oct = c ^ step;
-                if (!((beside->ready >> q) & 1u)) locate_neighbour_node(*beside, q, co, d, trace);
-                corner[k] = double((beside->is_leaf >> q) & 1u ? beside->leaf[q] : beside->node[q]->scalar[oct]);
-                continue;
-            }
-            const Coord q{co.x + ((k & 1) ? side : 0u), co.y + ((k & 2) ? side : 0u), co.z + ((k & 4) ? side : 0u)};
-            corner[k] = double(tree_.lattice_value(co, q, side, d, trace));
+            const InteriorNode<T>& n = *beside.node[q];
+            corner[k] = double(at_caps && !n.is_scalar_leaf(oct) ? tree_.cap_at(beside.first[q], n, oct).voxel(0) : n.scalar[oct]);
         }
     }
     /// The whole coarse cell of side `side` at co with `corner` on the ray's piece [t0, t1).
@@ -1139,20 +1089,14 @@ private:
         w.hit.cell_log2 = std::countr_zero(side);
         return true;
     }
-    /// Level of detail for the lanes `entered` of a packet into child c of node n at depth d (above
-    /// the cap parents), each on its piece [c0[k], c1[k]), where the cut stops there at `unit`: a
-    /// whole coarse cell has its corners read once for all the lanes (the same numbers as each
-    /// lane's coarse_child), anything else is walked lane by lane. Returns the lanes that hit.
-    /// 0.94-0.97 x the trace at F = 1 on plume and mixing 1024^3 against the build before it (min
-    /// of 7 pairs while a conversion loaded the host; build_ab_lod_shared_corners.json; its plume
-    /// 2048^3 row verified the file's blocks inside the frame, the A/Bs at 2048^3 after it use
-    /// --verify full).
+    /// coarse_child for the lanes `entered` of a packet, each on its piece [c0[k], c1[k]): a whole
+    /// coarse cell has its corners read once for all of them. Returns the lanes that hit.
     unsigned coarse_lanes(Packet& p, CapParent& beside, const InteriorNode<T>& n, int d, int c, const Coord& co, uint32_t half,
                           uint32_t unit, unsigned entered, const double* c0, const double* c1) const {
         unsigned hit = 0;
-        if (whole_coarse_child(d, co, half, unit)) {
+        if (whole_coarse_child(co, half, unit)) {
             double corner[8];
-            coarse_child_corners(p.trace, d, n, c, co, half, corner, &beside);
+            coarse_corners(beside, p.trace, d, c, co, corner);
             for (unsigned m = entered; m; m &= m - 1) {
                 const int k = std::countr_zero(m);
                 if (coarse_whole_cell(p.lane[k], co, half, corner, c0[k], c1[k])) hit |= 1u << k;
@@ -1161,7 +1105,7 @@ private:
         }
         for (unsigned m = entered; m; m &= m - 1) {
             const int k = std::countr_zero(m);
-            if (coarse_child(p.lane[k], p.trace, d, n, c, co, half, unit, c0[k], c1[k], &beside)) hit |= 1u << k;
+            if (coarse_cells(p.lane[k], p.trace, d, co, half, unit, n.is_scalar_leaf(c), n.scalar[c], c0[k], c1[k])) hit |= 1u << k;
         }
         return hit;
     }

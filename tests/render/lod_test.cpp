@@ -209,7 +209,7 @@ TEST(Lod, CloseUpAndLodZeroAreTheExactFrame) {
 
 /// A near eye makes the cut vary over the image, from full resolution to units of 16 and more:
 /// primary packets, whose lanes stopped at a whole coarse cell or a cap share its corners
-/// (traverse.h, coarse_lanes, coarse_cap_lanes), give every pixel the single rays' depth and
+/// (traverse.h, coarse_lanes, coarse_corners), give every pixel the single rays' depth and
 /// normal bit for bit, in both kernels, on a smooth field and on one of scalar leaves, and stop at
 /// every unit from 1 to 16.
 TEST(Lod, PacketsStopWhereSingleRaysStop) {
