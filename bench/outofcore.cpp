@@ -15,7 +15,6 @@
 #include <optional>
 #include <vector>
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <tbb/parallel_for.h>
@@ -133,17 +132,6 @@ struct RenderRow {
     uint64_t hits = 0;
 };
 
-/// Drops the file's pages from the page cache, so that every render starts cold: written back
-/// first (the converter has just written it), then dropped (clean pages of a file nobody maps:
-/// the kernel honours it without root).
-void evict(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY);
-    if (fd < 0) return;
-    ::fdatasync(fd);
-    ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
-    ::close(fd);
-}
-
 /// A 512^2 frame (--quick: 64^2) of `oct` at `iso`, afar (the default camera: the whole data)
 /// and close up (zoom 8: a corner of it), under --verify full and touched, each from a cold
 /// page cache, interleaved.
@@ -152,7 +140,7 @@ std::vector<RenderRow> cold_frames(const std::string& oct, const std::string& is
     std::vector<RenderRow> renders;
     for (const char* view : {"afar", "close"})
         for (const char* verify : {"full", "touched"}) {
-            evict(oct);
+            evict_page_cache(oct);
             std::vector<std::string> args{oct, "--iso", iso, "--size", quick ? "64x64" : "512x512", "--verify", verify, "--json", "-o", image};
             if (std::string(view) == "close") args.insert(args.end(), {"--zoom", "8"});
             if (threads) args.insert(args.end(), {"--threads", *threads});

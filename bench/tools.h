@@ -1,9 +1,11 @@
 // What the conversion benchmarks (compression, series) share: running a built octiso tool in a
 // child process (so its peak RSS is its own, not the benchmark's), reading numbers out of the one
-// flat JSON object the tools print, comparing a file with bytes in memory, and the zstd -3 size
-// of a buffer as the entropy-coder reference the compression tables print beside the octree.
+// flat JSON object the tools print, comparing a file with bytes in memory, the zstd -3 size
+// of a buffer as the entropy-coder reference the compression tables print beside the octree, and
+// dropping a file from the page cache for the cold-start rows (outofcore, lod --cold).
 #pragma once
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <zstd.h>
@@ -70,6 +72,17 @@ inline double json_number(const std::string& json, const std::string& key) {
     const size_t at = json.find(needle);
     if (at == std::string::npos) throw Error(key, "not in the tool's JSON output", ErrorKind::Other);
     return std::strtod(json.c_str() + at + needle.size(), nullptr);
+}
+
+/// Drops the file's pages from the page cache, so that the next process to map it starts cold:
+/// written back first (a converter may have just written it), then dropped (clean pages of a file
+/// nobody maps: the kernel honours it without root). Best effort: a file it cannot open is left.
+inline void evict_page_cache(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY);
+    if (fd < 0) return;
+    ::fdatasync(fd);
+    ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+    ::close(fd);
 }
 
 /// True if the file at `path` holds exactly the `n` bytes at `data` (read in blocks, no full copy).

@@ -8,13 +8,17 @@ same pixels (idiff -fail 0: a change meant to keep the image must).
 
     scripts/build_ab.py --a /work/wt-old/build/octiso-render [--b build/octiso-render] [--pairs 5]
                         [--threads 1] [--size 512x512] [--orbit 8] [--flags '--no-embree']
-                        [--colour] [--phase trace|shade|other|frame] [--results DIR] [--tag NAME] FILE.oct[,B_FILE.oct]@ISO ...
+                        [--colour] [--phase trace|shade|other|frame] [--cold] [--results DIR] [--tag NAME]
+                        FILE.oct[,B_FILE.oct]@ISO ...
 
 --colour also writes the colour image and compares it; --phase shade times the shading pass instead
 of the tile loop: with --colour --flags '--no-embree --ao 4' that is the ambient-occlusion rays,
 single rays from the hits in random directions (the renderer's incoherent rays). --phase frame times
 the whole frame (frame_seconds: tile loops, shading, and the rest such as the frame's buffers),
---phase other only that rest.
+--phase other only that rest. --cold drops the file from the page cache before every run
+(posix_fadvise DONTNEED: clean pages nobody maps) and times the first frame's whole wall time
+(frame_seconds of frame 0: its page faults' reads and, under --verify touched, its block checks),
+what a user waits for on opening a file; give --orbit 1.
 
 FILE.oct,B_FILE.oct: a format change, each build on its own conversion of the same voxels (A on FILE,
 B on B_FILE); the images are compared all the same.
@@ -34,13 +38,25 @@ def kinds(a):
     return [("depth", "exr"), ("normal", "exr")] + ([("colour", "png")] if a.colour else [])
 
 
+def evict(path):
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.posix_fadvise(fd, 0, 0, os.POSIX_FADV_DONTNEED)
+    finally:
+        os.close(fd)
+
+
 def render(binary, path, iso, a, outdir, tag):
+    if a.cold:
+        evict(path)
     outputs = {"depth": "--depth", "normal": "--normal", "colour": "-o"}
     cmd = [binary, path, "--iso", iso, "--orbit", str(a.orbit), "--threads", str(a.threads), "--size", a.size, "--json"]
     for kind, ext in kinds(a):
         cmd += [outputs[kind], os.path.join(outdir, f"{tag}_{kind}_%d.{ext}")]
     out = subprocess.run(cmd + a.flags.split(), check=True, capture_output=True, text=True).stdout
     frames = json.loads(out)["frames"]
+    if a.cold:
+        return frames[0]["frame_seconds"]
     if a.phase == "frame":   # the whole frame: tile loops, shading and the rest (buffers)
         return sum(f["frame_seconds"] for f in frames) / len(frames)
     return sum(f["phases"][a.phase] for f in frames) / len(frames)
@@ -68,6 +84,7 @@ def main():
     p.add_argument("--colour", action="store_true", help="also write and compare the colour image")
     p.add_argument("--phase", default="trace", choices=["trace", "shade", "other", "frame"],
                    help="the phase timed (phases of --json; frame: frame_seconds, all of them)")
+    p.add_argument("--cold", action="store_true", help="each run from a cold page cache, its first frame's wall time")
     p.add_argument("--results")
     p.add_argument("--tag", default="", help="the JSON is build_ab_TAG.json")
     a = p.parse_args()
@@ -96,7 +113,7 @@ def main():
     out = os.path.join(results, f"build_ab_{a.tag}.json" if a.tag else "build_ab.json")
     with open(out, "w") as f:
         json.dump({"a": a.a, "b": a.b, "pairs": a.pairs, "threads": a.threads, "size": a.size, "orbit": a.orbit,
-                   "flags": a.flags, "phase": a.phase, "colour": a.colour, "machine": platform.processor() or platform.machine(), "rows": rows}, f, indent=1)
+                   "flags": a.flags, "phase": "cold first frame" if a.cold else a.phase, "colour": a.colour, "machine": platform.processor() or platform.machine(), "rows": rows}, f, indent=1)
     print(f"JSON: {out}")
     return 0 if all(r["same_pixels"] for r in rows) else 1
 
