@@ -873,6 +873,20 @@ private:
         beside.ready |= 1u << q;
     }
 
+    /// Child `oct` of entry q of `beside` (the CapParent kept for the node at depth d that holds co;
+    /// the entry located on first use): the covering leaf's value, a scalar leaf's value, a cap
+    /// (a stored child of an entry at the cap parents, d = dmax-2), or above them a stored child's
+    /// scalar, the voxel at its lower corner (format 4). So voxel() of the result, its octant 0, is
+    /// that child's lower corner voxel at every depth.
+    OCTISO_ALWAYS_INLINE LeafRef<T> beside_child(CapParent& beside, int q, int oct, const Coord& co, int d,
+                                                 const uint32_t* trace) const {
+        if (!((beside.ready >> q) & 1u)) locate_neighbour_node(beside, q, co, d, trace);
+        if ((beside.is_leaf >> q) & 1u) return {beside.leaf[q], false, {}, 0};
+        const InteriorNode<T>& n = *beside.node[q];
+        if (n.is_scalar_leaf(oct) || d != tree_.dmax() - 2) return {n.scalar[oct], false, {}, 0};
+        return {T{}, true, tree_.cap_at(beside.first[q], n, oct), 0};
+    }
+
     /// Puts the lattice voxels of the blocks in `missing` into `blocks` (CapBlocks). Block r of the
     /// cap at octant c of its parent is child c ^ r of parent entry c & r: on the axes of r where c
     /// is already on the upper side, the block lies across the parent's face.
@@ -882,18 +896,8 @@ private:
         const int c = blocks.octant;
         for (unsigned m = missing; m; m &= m - 1) {
             const int r = std::countr_zero(m);
-            LeafRef<T> found{T{}, true, ref, 0};
-            if (r != 0) {
-                const int q = c & r, oct = c ^ r;
-                if (!((parent.ready >> q) & 1u)) locate_neighbour_node(parent, q, co, tree_.dmax() - 2, trace);
-                if ((parent.is_leaf >> q) & 1u) {
-                    found = {parent.leaf[q], false, {}, 0};
-                } else {
-                    const InteriorNode<T>& n = *parent.node[q];
-                    found = n.is_scalar_leaf(oct) ? LeafRef<T>{n.scalar[oct], false, {}, 0}
-                                                  : LeafRef<T>{T{}, true, tree_.cap_at(parent.first[q], n, oct), 0};
-                }
-            }
+            const LeafRef<T> found =
+                r == 0 ? LeafRef<T>{T{}, true, ref, 0} : beside_child(parent, c & r, c ^ r, co, tree_.dmax() - 2, trace);
             // The block's lattice voxels: 2 on the axes of r (its local 0), 0 or 1 on the others.
             for (int local = 0; local < 8; ++local) {
                 if (local & r) continue;
@@ -1045,7 +1049,8 @@ private:
     /// "Level of detail"). Everything else walks.
     bool coarse_child(RayState& w, const uint32_t* trace, int d, const InteriorNode<T>& n, int c, const Coord& co,
                       uint32_t side, uint32_t unit, double t0, double t1, CapParent& beside) const {
-        if (!whole_coarse_child(co, side, unit)) return coarse_cells(w, trace, d, co, side, unit, n.is_scalar_leaf(c), n.scalar[c], t0, t1);
+        if (!whole_coarse_child(co, side, unit))
+            return coarse_cells(w, trace, d, co, side, unit, n.is_scalar_leaf(c), n.scalar[c], t0, t1);
         double corner[8];
         coarse_corners(beside, trace, d, c, co, corner);
         return coarse_whole_cell(w, co, side, corner, t0, t1);
@@ -1067,17 +1072,9 @@ private:
     /// 0.956-0.967 x on plume and mixing 2048^3, where 84-96 % of the hits stop at unit 4
     /// (build_ab_lod_node_neighbours.json); every pixel the same.
     void coarse_corners(CapParent& beside, const uint32_t* trace, int d, int c, const Coord& co, double corner[8]) const {
-        const bool at_caps = d == tree_.dmax() - 2;
         for (int k = 0; k < 8; ++k) {
             const int r = ((k & 1) << 2) | (k & 2) | ((k >> 2) & 1);   // corner k (x = bit 0) as octant bits (x = 4)
-            const int q = c & r, oct = c ^ r;
-            if (!((beside.ready >> q) & 1u)) locate_neighbour_node(beside, q, co, d, trace);
-            if ((beside.is_leaf >> q) & 1u) {
-                corner[k] = double(beside.leaf[q]);
-                continue;
-            }
-            const InteriorNode<T>& n = *beside.node[q];
-            corner[k] = double(at_caps && !n.is_scalar_leaf(oct) ? tree_.cap_at(beside.first[q], n, oct).voxel(0) : n.scalar[oct]);
+            corner[k] = double(beside_child(beside, c & r, c ^ r, co, d, trace).voxel());
         }
     }
     /// The whole coarse cell of side `side` at co with `corner` on the ray's piece [t0, t1).
