@@ -206,12 +206,12 @@ std::vector<ColdFrame> cold_frames(const OctFile& mapped, const std::string& pat
     if (rounds == 0) return {};
     std::vector<ColdFrame> best(factors.size());
     const std::string out = (work / "cold.png").string();
+    const std::string size = std::to_string(image) + "x" + std::to_string(image);
     for (int round = 0; round < rounds; ++round)
         for (size_t i = 0; i < factors.size(); ++i) {
             const size_t k = (i + size_t(round)) % factors.size();
             mapped.release_resident_pages();
             evict_page_cache(path);
-            const std::string size = std::to_string(image) + "x" + std::to_string(image);
             const std::string json = run_tool("octiso-render", {path, "--iso", fmt(iso, 6), "--size", size, "--lod", fmt(factors[k], 6),
                                                                 "--threads", std::to_string(threads), "--json", "-o", out});
             const double seconds = json_number(json, "frame_seconds");

@@ -88,6 +88,8 @@ def main():
     p.add_argument("--results")
     p.add_argument("--tag", default="", help="the JSON is build_ab_TAG.json")
     a = p.parse_args()
+    if a.cold and a.orbit != 1:
+        p.error("--cold times a process's first frame: give --orbit 1")
     rows = []
     print(f"| file | iso | A min / median ms | B min / median ms | B / A (min) | B / A (median) | same pixels |")
     print("|---|---|---|---|---|---|---|")
