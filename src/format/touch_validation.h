@@ -23,8 +23,9 @@
 // against 2 MiB, a 512^2 frame of a 1.2-1.5 GiB file (plume, mixing 2048^3) from a cold page
 // cache took 0.80-0.88 x the time exact and 0.73-0.83 x at --lod 1 (min of 5 interleaved pairs,
 // build_ab_cold_blocks_256k_*.json; BENCHMARKS "Level of detail", tenth session), its checked
-// bytes down from 614 to 359 MiB and from 246 to 116 MiB (plume). Blocks of 256 KiB stand from
-// 1 GiB (where --verify auto turns to touched) up to 2 GiB; larger files take kMaxBlocks.
+// bytes down from 614 to 359 MiB and from 246 to 116 MiB (plume;
+// cold_blocks_scratch_counts_stop43.json). Blocks of 256 KiB stand from 1 GiB (where --verify
+// auto turns to touched) up to 2 GiB; larger files take kMaxBlocks.
 #pragma once
 
 #include <atomic>
