@@ -56,6 +56,40 @@ TYPED_TEST(RenderAgreement, MarschnerLobbAnisotropicWithEmbree) {
     expect_agreement(compare_with_reference(v, placement, cam, 60.0, true), "embree path");
 }
 
+/// Labels in blocks of 8 and 4 voxels (values 0, 10, 20, 30), as in an atlas: big scalar leaves
+/// whose shell cells (the last layer, whose corners lie in the forward neighbours) meet
+/// neighbours on the same side of the isovalue and on the other, in every combination. Every
+/// type, three isovalues between the labels and three octants must agree with the dense reference
+/// exactly in the mask: a shell cell skipped or read from the wrong neighbour shows as missed or
+/// extra pixels (a trial that skipped shell cells by their neighbours' bounds was checked here,
+/// and a broken cull in it failed with a third of the pixels off; BENCHMARKS.md packet section).
+TYPED_TEST(RenderAgreement, BlockyLabelsWithBigLeavesBetweenIsovalues) {
+    using T = TypeParam;
+    const Dims dims{45, 38, 41};
+    DenseVolume<T> v{dims, std::vector<T>(dims.voxels())};
+    std::mt19937 rng(7);
+    std::vector<int> coarse(6 * 5 * 6), fine(12 * 10 * 11);
+    for (int& l : coarse) l = int(rng() % 4u);
+    for (int& l : fine) l = rng() % 3u == 0 ? int(rng() % 4u) : -1;   // a third of the 4^3 blocks differ
+    for (uint32_t z = 0; z < dims.z; ++z)
+        for (uint32_t y = 0; y < dims.y; ++y)
+            for (uint32_t x = 0; x < dims.x; ++x) {
+                const int f = fine[(x >> 2) + 12 * ((y >> 2) + 10 * (z >> 2))];
+                const int label = f >= 0 ? f : coarse[(x >> 3) + 6 * ((y >> 3) + 5 * (z >> 3))];
+                v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = T(10 * label);
+            }
+    Placement placement;
+    const std::array<double, 3> centre{22, 18.5, 20};
+    for (double iso : {5.0, 15.0, 25.0}) {
+        for (int o = 0; o < 8; o += 3) {
+            const std::array<double, 3> eye{centre[0] + ((o & 1) ? 70 : -70), centre[1] + ((o & 2) ? 60 : -60),
+                                            centre[2] + ((o & 4) ? 55 : -55)};
+            expect_agreement(compare_with_reference(v, placement, look_at(eye, centre, {0, 0, 1}, 40, 56), iso),
+                             "iso " + std::to_string(iso) + " octant " + std::to_string(o));
+        }
+    }
+}
+
 TEST(RenderAgreementFields, NoiseSierpinskiTorusOddShapes) {
     const struct { Field field; Dims dims; double iso; } cases[] = {
         {Field::Noise, {17, 21, 13}, 56.0}, {Field::Sierpinski, {27, 27, 27}, 60.0},
