@@ -78,6 +78,21 @@ TYPED_TEST(RenderAgreement, BlockyLabelsWithBigLeavesBetweenIsovalues) {
                 const int label = f >= 0 ? f : coarse[(x >> 3) + 6 * ((y >> 3) + 5 * (z >> 3))];
                 v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = T(10 * label);
             }
+    // The premise: uniform aligned 4^3 blocks inside the data (scalar leaves of side >= 4, which
+    // the shell walk serves; side-2 leaves are walked as caps) with both labels below and above
+    // each isovalue among them.
+    int leaves = 0;
+    bool label_seen[4] = {};
+    for (uint32_t z = 0; z + 4 <= dims.z; z += 4)
+        for (uint32_t y = 0; y + 4 <= dims.y; y += 4)
+            for (uint32_t x = 0; x + 4 <= dims.x; x += 4) {
+                bool uniform = true;
+                for (uint32_t k = 0; k < 64; ++k) uniform &= v.at(x + (k & 3), y + ((k >> 2) & 3), z + (k >> 4)) == v.at(x, y, z);
+                leaves += uniform;
+                if (uniform) label_seen[int(v.at(x, y, z)) / 10] = true;
+            }
+    ASSERT_GT(leaves, 200);
+    for (int l = 0; l < 4; ++l) ASSERT_TRUE(label_seen[l]) << "no uniform 4^3 block of label " << l;
     Placement placement;
     const std::array<double, 3> centre{22, 18.5, 20};
     for (double iso : {5.0, 15.0, 25.0}) {
