@@ -41,6 +41,7 @@
 #include "render/live_children.h"
 #include "render/lod.h"
 #include "render/packet_size.h"
+#include "render/packet_start.h"
 #include "math/ray.h"
 #include "render/roots.h"
 #include "util/check.h"
@@ -169,6 +170,11 @@ public:
         OCTISO_DCHECK(count >= 0 && count <= kMaxPacket, "packet of ", count);
         Packet p;
         unsigned by_flip[8] = {};
+#if defined(__AVX2__)
+        if (scene_.has_cells) {
+            start_lanes(p, rays, count, valid, want_normal, by_flip);
+        } else
+#endif
         for (int k = 0; k < kMaxPacket; ++k) {
             p.t0[k] = std::numeric_limits<double>::infinity(), p.t1[k] = -std::numeric_limits<double>::infinity();
             if (k >= count || (valid && !valid[k])) continue;
@@ -179,11 +185,12 @@ public:
             by_flip[(dir[0] < 0 ? 4 : 0) | (dir[1] < 0 ? 2 : 0) | (dir[2] < 0 ? 1 : 0)] |= 1u << k;
         }
 #if defined(__AVX2__)
-        for (int a = 0; a < 3; ++a)
-            for (int k = 0; k < kMaxPacket; ++k) {
-                const IndexRay& r = p.lane[k].ray;
-                p.origin[a][k] = r.origin[a], p.dir[a][k] = r.dir[a], p.inv_dir[a][k] = r.inv_dir[a];
-            }
+        if (!scene_.has_cells)
+            for (int a = 0; a < 3; ++a)
+                for (int k = 0; k < kMaxPacket; ++k) {
+                    const IndexRay& r = p.lane[k].ray;
+                    p.origin[a][k] = r.origin[a], p.dir[a][k] = r.dir[a], p.inv_dir[a][k] = r.inv_dir[a];
+                }
 #endif
         for (int flip = 0; flip < 8; ++flip) {
             const unsigned lanes = by_flip[flip];
@@ -373,6 +380,37 @@ private:
 #endif
         uint32_t trace[kMaxDepth];
     };
+
+#if defined(__AVX2__)
+    /// trace_packet's lane starts four lanes at a time (packet_start.h): every lane's index ray,
+    /// piece [t0, t1) and direction-sign group as RayState::start and the loop of the portable
+    /// kernel give them, bit for bit, and the lanes' rays by axis for PacketSplit.
+    void start_lanes(Packet& p, const Ray* rays, int count, const int* valid, bool want_normal, unsigned by_flip[8]) const {
+        for (int k0 = 0; k0 < kMaxPacket; k0 += 4) {
+            LaneStarts4 s;
+            start_four_lanes(scene_, rays, k0, count, valid, s);
+            for (int a = 0; a < 3; ++a) {
+                store4(&p.origin[a][k0], s.origin[a]);
+                store4(&p.dir[a][k0], s.dir[a]);
+                store4(&p.inv_dir[a][k0], s.inv_dir[a]);
+            }
+            store4(&p.t0[k0], s.t_in);
+            store4(&p.t1[k0], s.t_out);
+            for (int j = 0; j < 4; ++j) {
+                const int k = k0 + j;
+                if (k >= count || (valid && !valid[k])) continue;
+                Walk& w = p.lane[k];
+                w.world_dir = rays[k].dir;
+                w.want_normal = want_normal;
+                for (int a = 0; a < 3; ++a)
+                    w.ray.origin[a] = s.origin[a][j], w.ray.dir[a] = s.dir[a][j], w.ray.inv_dir[a] = s.inv_dir[a][j];
+                w.t_exit = s.t_out[j];
+                if (!s.live[j]) continue;
+                by_flip[(s.dir[0][j] < 0 ? 4 : 0) | (s.dir[1][j] < 0 ? 2 : 0) | (s.dir[2][j] < 0 ? 1 : 0)] |= 1u << k;
+            }
+        }
+    }
+#endif
 
 #if defined(__AVX2__)
     /// The lanes' pieces of a node's children, four lanes at a time (the AVX2 kernel): per lane its
