@@ -207,14 +207,13 @@ void render_mesh_frame(const MeshScene& ms, const Camera& camera, bool vertex_no
             if (rays != MeshRays::single) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
             // One packet of bw x bh pixels, one rtcIntersect8 / rtcIntersect16 call (RayHitN with N lanes).
             const auto trace_block = [&]<class RayHitN, int N>(int x0, int y0, int bw, int bh, auto intersect) {
-                int count = 0;
+                // The rays as render() makes them (PinholeCamera::block_rays, the same bits as ray()).
+                const int w = std::min(bw, tile.x1 - x0), h = std::min(bh, tile.y1 - y0);
+                const int count = w * h;
                 Ray ray[N];
                 size_t pixel[N];
-                for (int py = y0; py < std::min(y0 + bh, tile.y1); ++py)
-                    for (int px = x0; px < std::min(x0 + bw, tile.x1); ++px) {
-                        ray[count] = pinhole.ray(px, py);
-                        pixel[count++] = size_t(py) * W + size_t(px);
-                    }
+                pinhole.block_rays(x0, y0, w, h, ray);
+                for (int k = 0; k < count; ++k) pixel[k] = size_t(y0 + k / w) * W + size_t(x0 + k % w);
                 alignas(64) RayHitN rh{};
                 alignas(64) int valid[N];
                 for (int k = 0; k < N; ++k) {

@@ -80,6 +80,8 @@ constexpr int kEmbreePacketW = 4, kEmbreePacketH = 2;
 static_assert(kEmbreePacketW * kEmbreePacketH == EmbreeVolumeScene::kPacket);
 constexpr int kDirectPacketW = 4, kDirectPacketH = 4;
 static_assert(kDirectPacketW * kDirectPacketH == kMaxTracePacket);
+static_assert(kDirectPacketW <= PinholeCamera::kMaxBlockSide && kDirectPacketH <= PinholeCamera::kMaxBlockSide &&
+              kMaxTracePacket <= PinholeCamera::kMaxBlockRays);
 
 void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, const PinholeCamera& pinhole,
                 const RenderOptions& options, const PixelRect& rect, Frame& frame, TileCounters& counters) {
@@ -96,13 +98,13 @@ void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, cons
     size_t pixel[kPacket];
     for (int y0 = rect.y0; y0 < rect.y1; y0 += packet_h)
         for (int x0 = rect.x0; x0 < rect.x1; x0 += packet_w) {
-            int count = 0;
-            for (int py = y0; py < std::min(y0 + packet_h, rect.y1); ++py)
-                for (int px = x0; px < std::min(x0 + packet_w, rect.x1); ++px) {
-                    rays[count] = pinhole.ray(px, py);
-                    if (!clip_planes.empty()) clip_ray(clip_planes, rays[count]);
-                    pixel[count++] = size_t(py) * W + size_t(px);
-                }
+            const int bw = std::min(packet_w, rect.x1 - x0), bh = std::min(packet_h, rect.y1 - y0);
+            const int count = bw * bh;
+            pinhole.block_rays(x0, y0, bw, bh, rays);
+            for (int k = 0; k < count; ++k) {
+                if (!clip_planes.empty()) clip_ray(clip_planes, rays[k]);
+                pixel[k] = size_t(y0 + k / bw) * W + size_t(x0 + k % bw);
+            }
             if (scene) scene->intersect_packet(rays, count, want_normal, traced);
             else if (packets) kernel.trace_packet(kernel.user, rays, count, nullptr, want_normal, traced);
             else for (int k = 0; k < count; ++k) traced[k] = kernel.trace(kernel.user, rays[k], want_normal);

@@ -3,7 +3,9 @@
 // out again by hand in long double, without PinholeCamera's helpers, and compared with it (corners,
 // centre, odd and non-square sizes, an up vector not orthogonal to the view), and render()'s depth
 // of an analytic plane is compared with where those hand-made rays meet the plane.
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -68,6 +70,37 @@ TEST(PinholeCameraConventions, EveryPixelRayIsTheFormulaWrittenOut) {
                 }
             }
     }
+}
+
+/// The renderer's packets take their rays from block_rays (screen coordinates once per column and
+/// row, normalisations two at a time): every block shape up to 8 x 2 and 4 x 4, wherever it lands
+/// (cut by the image's edge too), on every camera above and one with a sub-pixel offset, gives
+/// ray(px, py) bit for bit.
+TEST(PinholeCameraConventions, BlockRaysAreTheSinglePixelRaysBitForBit) {
+    std::vector<Camera> cameras(std::begin(kCameras), std::end(kCameras));
+    Camera shifted = kCameras[4];
+    shifted.pixel_offset = {0.3125, -0.41};
+    cameras.push_back(shifted);
+    int blocks = 0;
+    for (const Camera& c : cameras) {
+        SCOPED_TRACE(::testing::Message() << c.width << "x" << c.height << " fov " << c.fov_deg);
+        const PinholeCamera pinhole(c);
+        for (int bw = 1; bw <= PinholeCamera::kMaxBlockSide; ++bw)
+            for (int bh = 1; bh <= PinholeCamera::kMaxBlockSide && bw * bh <= PinholeCamera::kMaxBlockRays; ++bh)
+                for (int y0 = 0; y0 < c.height; y0 += bh)
+                    for (int x0 = 0; x0 < c.width; x0 += bw) {
+                        const int w = std::min(bw, c.width - x0), h = std::min(bh, c.height - y0);
+                        Ray block[PinholeCamera::kMaxBlockRays];
+                        pinhole.block_rays(x0, y0, w, h, block);
+                        ++blocks;
+                        for (int k = 0; k < w * h; ++k) {
+                            const Ray one = pinhole.ray(x0 + k % w, y0 + k / w);
+                            ASSERT_EQ(std::memcmp(&one, &block[k], sizeof(Ray)), 0)
+                                << "block " << bw << "x" << bh << " at " << x0 << "," << y0 << ", ray " << k;
+                        }
+                    }
+    }
+    EXPECT_GT(blocks, 1000);
 }
 
 TEST(PinholeCameraConventions, CornersCentreAndOrientation) {
