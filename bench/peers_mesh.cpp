@@ -213,7 +213,8 @@ void render_mesh_frame(const MeshScene& ms, const Camera& camera, bool vertex_no
                 Ray ray[N];
                 size_t pixel[N];
                 pinhole.block_rays(x0, y0, w, h, ray);
-                for (int k = 0; k < count; ++k) pixel[k] = size_t(y0 + k / w) * W + size_t(x0 + k % w);
+                for (int j = 0, k = 0; j < h; ++j)
+                    for (int i = 0; i < w; ++i) pixel[k++] = size_t(y0 + j) * W + size_t(x0 + i);
                 alignas(64) RayHitN rh{};
                 alignas(64) int valid[N];
                 for (int k = 0; k < N; ++k) {

@@ -101,10 +101,11 @@ void trace_rect(const TracerKernel& kernel, const EmbreeVolumeScene* scene, cons
             const int bw = std::min(packet_w, rect.x1 - x0), bh = std::min(packet_h, rect.y1 - y0);
             const int count = bw * bh;
             pinhole.block_rays(x0, y0, bw, bh, rays);
-            for (int k = 0; k < count; ++k) {
-                if (!clip_planes.empty()) clip_ray(clip_planes, rays[k]);
-                pixel[k] = size_t(y0 + k / bw) * W + size_t(x0 + k % bw);
-            }
+            for (int j = 0, k = 0; j < bh; ++j)
+                for (int i = 0; i < bw; ++i, ++k) {
+                    if (!clip_planes.empty()) clip_ray(clip_planes, rays[k]);
+                    pixel[k] = size_t(y0 + j) * W + size_t(x0 + i);
+                }
             if (scene) scene->intersect_packet(rays, count, want_normal, traced);
             else if (packets) kernel.trace_packet(kernel.user, rays, count, nullptr, want_normal, traced);
             else for (int k = 0; k < count; ++k) traced[k] = kernel.trace(kernel.user, rays[k], want_normal);
