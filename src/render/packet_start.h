@@ -12,7 +12,6 @@
 
 #if defined(__AVX2__)
 
-#include <cstring>
 #include <limits>
 
 #include "math/ray.h"

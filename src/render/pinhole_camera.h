@@ -37,11 +37,12 @@ public:
     /// The most pixels block_rays() takes along a side, and in all.
     static constexpr int kMaxBlockSide = 8, kMaxBlockRays = 16;
     /// The rays of the w x h pixels at (x0, y0), row by row into out[0 .. w*h): ray(px, py) bit
-    /// for bit (w, h in 1 .. kMaxBlockSide, w * h <= kMaxBlockRays). A column's and a row's screen coordinate are
-    /// computed once for the block, and the normalisations two rays at a time (SSE2 sqrtpd,
-    /// divpd: the same correctly rounded operations as sqrt and the scalar divisions). Why: with
-    /// no surface in view a 512^2 frame of ch2better still took 8-12 ms, and perf put 15 % of its
-    /// samples in this per-pixel arithmetic (BENCHMARKS.md, packet section, eleventh session).
+    /// for bit (w, h in 1 .. kMaxBlockSide, w * h <= kMaxBlockRays). A column's and a row's
+    /// screen coordinate are computed once for the block, and the normalisations two rays at a
+    /// time (SSE2 sqrtpd, divpd: the same correctly rounded operations as sqrt and the scalar
+    /// divisions). Why: with no surface in view a 512^2 frame of ch2better still took 8-12 ms,
+    /// and perf put 15 % of its samples in this per-pixel arithmetic (BENCHMARKS.md, packet
+    /// section, eleventh session).
     void block_rays(int x0, int y0, int w, int h, Ray* out) const {
         double sx[kMaxBlockSide], sy[kMaxBlockSide];
         for (int i = 0; i < w; ++i) sx[i] = screen_x(x0 + i);
