@@ -16,6 +16,7 @@
 
 #include "math/ray.h"
 #include "render/cell_hit.h"
+#include "render/simd4.h"
 #include "util/isa.h"
 
 namespace octiso {
@@ -23,24 +24,21 @@ OCTISO_ISA_BEGIN
 
 /// Four lanes' starts by axis: lane j of a group at [a][j].
 struct LaneStarts4 {
-    using V4d = double __attribute__((vector_size(32)));
-    using V4l = decltype(V4d{} < V4d{});   ///< a compare's mask (GCC: four longs)
     V4d origin[3], dir[3], inv_dir[3];
     V4d t_in, t_out;   ///< the box clip; an empty one is (+inf, -inf), BoxClip's default
-    V4l live;          ///< -1 where the lane is valid and its piece not empty
+    V4m given;         ///< -1 where the lane has a ray (k < count, valid[k] != 0)
+    V4m live;          ///< -1 where the lane has a ray and its piece is not empty
 };
 
 /// Lanes k0 .. k0+3 of `rays` (count rays in all, valid[k] == 0 or k >= count: no ray, an empty
-/// piece and a zero index ray, as a lane never started). Requires scene.has_cells (else
-/// RayState::start leaves the ray unset; the caller starts lane by lane then).
+/// piece and a zero index ray, as a lane never started). In a volume without cells
+/// (!scene.has_cells) every piece is empty, as RayState::start returns it.
 OCTISO_ALWAYS_INLINE void start_four_lanes(const CellWalkScene& scene, const Ray* rays, int k0, int count, const int* valid,
                                            LaneStarts4& out) {
-    using V4d = LaneStarts4::V4d;
-    using V4l = LaneStarts4::V4l;
     constexpr double inf = std::numeric_limits<double>::infinity();
     static const Ray kNoRay{};
     const Ray* r[4];
-    V4l given{};
+    V4m given{};
     for (int j = 0; j < 4; ++j) {
         const int k = k0 + j;
         const bool on = k < count && (!valid || valid[k]);
@@ -61,7 +59,7 @@ OCTISO_ALWAYS_INLINE void start_four_lanes(const CellWalkScene& scene, const Ray
         const V4d d = dw / so;
         const V4d one{1.0, 1.0, 1.0, 1.0};
         const V4d inv = d == zero ? zero : one / d;
-        const V4l flush = ~finite(inv);   // a reciprocal that overflows: the axis counts as parallel
+        const V4m flush = ~finite(inv);   // a reciprocal that overflows: the axis counts as parallel
         out.dir[a] = flush ? zero : d;
         out.inv_dir[a] = flush ? zero : inv;
     }
@@ -69,17 +67,18 @@ OCTISO_ALWAYS_INLINE void start_four_lanes(const CellWalkScene& scene, const Ray
     // clip_to_box(ray, box_hi, ray_world).
     const V4d t_min = lanes([](const Ray& ray) { return ray.t_min; });
     const V4d t_max = lanes([](const Ray& ray) { return ray.t_max; });
-    V4l live = given & (t_min <= t_max);
+    V4m live = given & (t_min <= t_max);
+    if (!scene.has_cells) live = V4m{};
     V4d t_in = t_min, t_out = inf4;
     for (int a = 0; a < 3; ++a) {
         const double hi = scene.box_hi[a];
-        if (!(hi >= 0)) live = V4l{};
+        if (!(hi >= 0)) live = V4m{};
         const V4d o = out.origin[a], d = out.dir[a], inv = out.inv_dir[a];
         const V4d hi4{hi, hi, hi, hi};
         live &= finite(o) & finite(d);
-        const V4l parallel = d == zero;
+        const V4m parallel = d == zero;
         live &= ~(parallel & ((o < zero) | (o > hi4)));
-        const V4l up = d > zero;
+        const V4m up = d > zero;
         const V4d t_lo = ((up ? zero : hi4) - o) * inv;
         const V4d t_hi = ((up ? hi4 : zero) - o) * inv;
         t_in = (~parallel & (t_in < t_lo)) ? t_lo : t_in;     // std::max(t_in, t_lo)
@@ -90,6 +89,7 @@ OCTISO_ALWAYS_INLINE void start_four_lanes(const CellWalkScene& scene, const Ray
     live &= t_in <= t_out;
     out.t_in = live ? t_in : inf4;
     out.t_out = live ? t_out : -inf4;
+    out.given = given;
     out.live = live;
     for (int a = 0; a < 3; ++a) {   // a lane never started keeps a zero index ray
         out.origin[a] = given ? out.origin[a] : zero;

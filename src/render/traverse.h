@@ -42,6 +42,7 @@
 #include "render/lod.h"
 #include "render/packet_size.h"
 #include "render/packet_start.h"
+#include "render/simd4.h"
 #include "math/ray.h"
 #include "render/roots.h"
 #include "util/check.h"
@@ -53,16 +54,6 @@
 
 namespace octiso {
 OCTISO_ISA_BEGIN
-
-#if defined(__AVX2__)
-/// Four doubles (and their compare masks) for the AVX2 kernel's packet split (PacketSplit): GCC
-/// vector extensions, one AVX2 register each. The operations are the scalar IEEE ones lane by
-/// lane (no FMA: -ffp-contract=off), so the results are the scalar ones bit for bit.
-using V4d = double __attribute__((vector_size(32)));
-using V4l = long long __attribute__((vector_size(32)));
-OCTISO_ALWAYS_INLINE void load4(V4d& v, const double* p) { std::memcpy(&v, p, sizeof v); }
-OCTISO_ALWAYS_INLINE void store4(double* p, const V4d& v) { std::memcpy(p, &v, sizeof v); }
-#endif
 
 /// Blocks of a cap's corner lattice (OctreeTracer::CapBlocks) whose voxels the cell of octant `oct`
 /// reads: every block r with r & ~oct == 0.
@@ -171,10 +162,8 @@ public:
         Packet p;
         unsigned by_flip[8] = {};
 #if defined(__AVX2__)
-        if (scene_.has_cells) {
-            start_lanes(p, rays, count, valid, want_normal, by_flip);
-        } else
-#endif
+        start_lanes(p, rays, count, valid, want_normal, by_flip);
+#else
         for (int k = 0; k < kMaxPacket; ++k) {
             p.t0[k] = std::numeric_limits<double>::infinity(), p.t1[k] = -std::numeric_limits<double>::infinity();
             if (k >= count || (valid && !valid[k])) continue;
@@ -184,13 +173,6 @@ public:
             const auto& dir = p.lane[k].ray.dir;
             by_flip[(dir[0] < 0 ? 4 : 0) | (dir[1] < 0 ? 2 : 0) | (dir[2] < 0 ? 1 : 0)] |= 1u << k;
         }
-#if defined(__AVX2__)
-        if (!scene_.has_cells)
-            for (int a = 0; a < 3; ++a)
-                for (int k = 0; k < kMaxPacket; ++k) {
-                    const IndexRay& r = p.lane[k].ray;
-                    p.origin[a][k] = r.origin[a], p.dir[a][k] = r.dir[a], p.inv_dir[a][k] = r.inv_dir[a];
-                }
 #endif
         for (int flip = 0; flip < 8; ++flip) {
             const unsigned lanes = by_flip[flip];
@@ -382,9 +364,11 @@ private:
     };
 
 #if defined(__AVX2__)
-    /// trace_packet's lane starts four lanes at a time (packet_start.h): every lane's index ray,
-    /// piece [t0, t1) and direction-sign group as RayState::start and the loop of the portable
-    /// kernel give them, bit for bit, and the lanes' rays by axis for PacketSplit.
+    /// trace_packet's lane starts four lanes at a time (packet_start.h): every lane's piece
+    /// [t0, t1) and direction-sign group as RayState::start and the loop of the portable kernel
+    /// give them, bit for bit, its index ray (the same bits wherever the data have cells: a lane
+    /// of a volume without cells starts empty and is never traversed), and the lanes' rays by axis
+    /// for PacketSplit.
     void start_lanes(Packet& p, const Ray* rays, int count, const int* valid, bool want_normal, unsigned by_flip[8]) const {
         for (int k0 = 0; k0 < kMaxPacket; k0 += 4) {
             LaneStarts4 s;
@@ -397,8 +381,8 @@ private:
             store4(&p.t0[k0], s.t_in);
             store4(&p.t1[k0], s.t_out);
             for (int j = 0; j < 4; ++j) {
+                if (!s.given[j]) continue;
                 const int k = k0 + j;
-                if (k >= count || (valid && !valid[k])) continue;
                 Walk& w = p.lane[k];
                 w.world_dir = rays[k].dir;
                 w.want_normal = want_normal;
