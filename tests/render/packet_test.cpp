@@ -164,6 +164,59 @@ TEST(PacketTraversal, CloseUpFramesWhosePacketsShareCapsAreIdentical) {
     }
 }
 
+/// Scalar leaves of side 4 (children of the nodes at depth dmax-3) are crossed by a packet as cap
+/// parents of constant caps (OctreeTracer::packet_leaf_cap_parent), by a single ray with the leaf
+/// walk (scalar_leaf): labels in uniform 4^3 and 8^3 blocks, isovalues between the labels and equal
+/// to them (then the cap at the leaf's origin, whose corners all lie inside the leaf, is walked
+/// too), views from four octants, and every frame of packets on both kernels must equal the
+/// single-ray frame bit for bit.
+TEST(PacketTraversal, SideFourLeavesAsCapParentsEqualTheLeafWalk) {
+    const Dims dims{45, 38, 41};
+    DenseVolume<uint8_t> v{dims, std::vector<uint8_t>(dims.voxels())};
+    std::mt19937 rng(3);
+    std::vector<int> coarse(6 * 5 * 6), fine(12 * 10 * 11);
+    for (int& l : coarse) l = int(rng() % 4u);
+    for (int& l : fine) l = rng() % 3u == 0 ? int(rng() % 4u) : -1;
+    for (uint32_t z = 0; z < dims.z; ++z)
+        for (uint32_t y = 0; y < dims.y; ++y)
+            for (uint32_t x = 0; x < dims.x; ++x) {
+                const int f = fine[(x >> 2) + 12 * ((y >> 2) + 10 * (z >> 2))];
+                const int label = f >= 0 ? f : coarse[(x >> 3) + 6 * ((y >> 3) + 5 * (z >> 3))];
+                v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = uint8_t(10 * label);
+            }
+    const OctreeData<uint8_t> data = build_octree(v.view(), {});
+    const Octree<uint8_t> tree = data.view();
+    uint64_t side_four_leaves = 0;   // the premise: the path under test has leaves to walk
+    const int d = tree.dmax() - 3;
+    for (uint64_t i = 0; i < tree.node_count(d); ++i)
+        for (int c = 0; c < 8; ++c) side_four_leaves += tree.node(d, i).is_scalar_leaf(c);
+    ASSERT_GT(side_four_leaves, 100u);
+    std::vector<Isa> isas{Isa::baseline};
+    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    RenderOptions single;
+    single.want_depth = single.want_normal = true;
+    single.traversal = Traversal::single;
+    single.isa = Isa::baseline;
+    single.use_embree = false;
+    for (const std::vector<double>& isos : {std::vector<double>{15.0}, std::vector<double>{10.0}, std::vector<double>{20.0, 5.0}}) {
+        single.isovalues = isos;
+        for (double azimuth : {30.0, 130.0, 215.0, 300.0}) {
+            const Camera camera = orbit_camera(dims, Placement{}, 120, 104, azimuth, azimuth > 180 ? -25.0 : 35.0, 1.0);
+            const Frame reference = render(data.view(), Placement{}, camera, single);
+            ASSERT_GT(reference.stats.hits, 3000u);
+            for (Isa isa : isas) {
+                RenderOptions o = single;
+                o.traversal = Traversal::packets, o.isa = isa;
+                const Frame f = render(data.view(), Placement{}, camera, o);
+                const std::string what = "iso " + std::to_string(isos[0]) + ", azimuth " + std::to_string(azimuth) + ", isa " +
+                                         std::to_string(int(isa));
+                EXPECT_EQ(0, std::memcmp(f.depth.data(), reference.depth.data(), f.depth.size() * sizeof(float))) << what;
+                EXPECT_EQ(0, std::memcmp(f.normal.data(), reference.normal.data(), f.normal.size() * sizeof(float))) << what;
+            }
+        }
+    }
+}
+
 /// The beam (OctreeTracer::beam_node: packets of rays from one origin cross the upper levels as
 /// one) against single rays in both kernels: packets of 16 rays from origins on mid-planes of
 /// several levels, aimed at node corners and at edge and face points of lattices of 2 to 16
