@@ -50,6 +50,27 @@ template <typename T> DenseVolume<T> make_volume(Dims dims, Pattern pattern, uin
     return v;
 }
 
+/// Labels 0, 10, 20, 30 in uniform blocks, as in an atlas: 8^3 blocks, a third of whose 4^3 blocks
+/// take a label of their own, drawn from `seed`. Their trees hold scalar leaves of side 4 and 8
+/// whose shell cells meet neighbours of every label.
+template <typename T> DenseVolume<T> label_blocks(Dims dims, uint32_t seed) {
+    DenseVolume<T> v{dims, std::vector<T>(dims.voxels())};
+    std::mt19937 rng(seed);
+    const uint32_t coarse_x = (dims.x + 7) / 8, coarse_y = (dims.y + 7) / 8, coarse_z = (dims.z + 7) / 8;
+    const uint32_t fine_x = (dims.x + 3) / 4, fine_y = (dims.y + 3) / 4, fine_z = (dims.z + 3) / 4;
+    std::vector<int> coarse(size_t(coarse_x) * coarse_y * coarse_z), fine(size_t(fine_x) * fine_y * fine_z);
+    for (int& l : coarse) l = int(rng() % 4u);
+    for (int& l : fine) l = rng() % 3u == 0 ? int(rng() % 4u) : -1;
+    for (uint32_t z = 0; z < dims.z; ++z)
+        for (uint32_t y = 0; y < dims.y; ++y)
+            for (uint32_t x = 0; x < dims.x; ++x) {
+                const int f = fine[(x >> 2) + fine_x * ((y >> 2) + fine_y * size_t(z >> 2))];
+                const int label = f >= 0 ? f : coarse[(x >> 3) + coarse_x * ((y >> 3) + coarse_y * size_t(z >> 3))];
+                v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = T(10 * label);
+            }
+    return v;
+}
+
 /// Calls visit(depth, node_index, origin) for every stored interior node, parents first.
 template <typename T>
 void for_each_node(const Octree<T>& tree, const std::function<void(int, uint32_t, Coord)>& visit) {

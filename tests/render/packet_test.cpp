@@ -172,18 +172,7 @@ TEST(PacketTraversal, CloseUpFramesWhosePacketsShareCapsAreIdentical) {
 /// single-ray frame bit for bit.
 TEST(PacketTraversal, SideFourLeavesAsCapParentsEqualTheLeafWalk) {
     const Dims dims{45, 38, 41};
-    DenseVolume<uint8_t> v{dims, std::vector<uint8_t>(dims.voxels())};
-    std::mt19937 rng(3);
-    std::vector<int> coarse(6 * 5 * 6), fine(12 * 10 * 11);
-    for (int& l : coarse) l = int(rng() % 4u);
-    for (int& l : fine) l = rng() % 3u == 0 ? int(rng() % 4u) : -1;
-    for (uint32_t z = 0; z < dims.z; ++z)
-        for (uint32_t y = 0; y < dims.y; ++y)
-            for (uint32_t x = 0; x < dims.x; ++x) {
-                const int f = fine[(x >> 2) + 12 * ((y >> 2) + 10 * (z >> 2))];
-                const int label = f >= 0 ? f : coarse[(x >> 3) + 6 * ((y >> 3) + 5 * (z >> 3))];
-                v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = uint8_t(10 * label);
-            }
+    const DenseVolume<uint8_t> v = label_blocks<uint8_t>(dims, 3);
     const OctreeData<uint8_t> data = build_octree(v.view(), {});
     const Octree<uint8_t> tree = data.view();
     uint64_t side_four_leaves = 0;   // the premise: the path under test has leaves to walk

@@ -66,18 +66,7 @@ TYPED_TEST(RenderAgreement, MarschnerLobbAnisotropicWithEmbree) {
 TYPED_TEST(RenderAgreement, BlockyLabelsWithBigLeavesBetweenIsovalues) {
     using T = TypeParam;
     const Dims dims{45, 38, 41};
-    DenseVolume<T> v{dims, std::vector<T>(dims.voxels())};
-    std::mt19937 rng(7);
-    std::vector<int> coarse(6 * 5 * 6), fine(12 * 10 * 11);
-    for (int& l : coarse) l = int(rng() % 4u);
-    for (int& l : fine) l = rng() % 3u == 0 ? int(rng() % 4u) : -1;   // a third of the 4^3 blocks differ
-    for (uint32_t z = 0; z < dims.z; ++z)
-        for (uint32_t y = 0; y < dims.y; ++y)
-            for (uint32_t x = 0; x < dims.x; ++x) {
-                const int f = fine[(x >> 2) + 12 * ((y >> 2) + 10 * (z >> 2))];
-                const int label = f >= 0 ? f : coarse[(x >> 3) + 6 * ((y >> 3) + 5 * (z >> 3))];
-                v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = T(10 * label);
-            }
+    const DenseVolume<T> v = label_blocks<T>(dims, 7);
     // The premise: uniform aligned 4^3 blocks inside the data (scalar leaves of side >= 4, which
     // the shell walk serves; side-2 leaves are walked as caps) with both labels below and above
     // each isovalue among them.
