@@ -68,8 +68,8 @@ TYPED_TEST(RenderAgreement, BlockyLabelsWithBigLeavesBetweenIsovalues) {
     const Dims dims{45, 38, 41};
     const DenseVolume<T> v = label_blocks<T>(dims, 7);
     // The premise: uniform aligned 4^3 blocks inside the data (scalar leaves of side >= 4, which
-    // the shell walk serves; side-2 leaves are walked as caps) with both labels below and above
-    // each isovalue among them.
+    // the shell walk serves, or for side 4 under a packet the caps' path; side-2 leaves are
+    // walked as caps) with both labels below and above each isovalue among them.
     int leaves = 0;
     bool label_seen[4] = {};
     for (uint32_t z = 0; z + 4 <= dims.z; z += 4)
