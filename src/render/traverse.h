@@ -666,7 +666,7 @@ private:
 
     /// A scalar leaf of side 4 (a child of a node at depth dmax-3) crossed by the lanes `entered`
     /// as a cap parent whose 8 caps are constant caps of its value: the packet split at its
-    /// mid-planes, each cap walked by packet_leaf_cap's path with its corner lattice read through
+    /// mid-planes, each quarter a side-2 leaf for packet_leaf_cap, its corner lattice read through
     /// the leaf's forward neighbours at the cap parents' depth (located once for all its caps and
     /// lanes) instead of the leaf walk's DDA and a neighbour descent per corner beyond the leaf.
     /// The cap at the leaf's origin has every corner inside the leaf: skipped unless an isovalue
@@ -678,8 +678,7 @@ private:
     /// Returns the lanes that hit.
     [[gnu::noinline]] unsigned packet_leaf_cap_parent(Packet& p, T value, const Coord& o, unsigned entered, int flip,
                                                       const double* t0, const double* t1) const {
-        bool iso_equals_value = false;
-        for (int i = 0; i < scene_.iso_count; ++i) iso_equals_value |= scene_.isovalues[i] == double(value);
+        const bool iso_equals_value = scene_.any_iso_in(double(value), double(value));
         CapParent parent(value);
         PacketSplit split;
         split.split(*this, p, o, 2, entered, t0, t1);
@@ -689,8 +688,7 @@ private:
             if (c == 0 && !iso_equals_value) continue;
             const unsigned lanes = split.enter(c, active);
             if (!lanes) continue;
-            CapBlocks blocks(parent, int(c));
-            active &= ~cap_lanes(p, constant_cap(value), child_origin_of(o, int(c), 2), lanes, flip, split.lo(c), split.hi(c), blocks);
+            active &= ~packet_leaf_cap(p, parent, int(c), value, child_origin_of(o, int(c), 2), lanes, flip, split.lo(c), split.hi(c));
         }
         return entered & ~active;
     }
