@@ -2,6 +2,7 @@
 // every stored node with its origin, and the exact cell range of a box computed from the array.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -68,6 +69,31 @@ template <typename T> DenseVolume<T> label_blocks(Dims dims, uint32_t seed) {
                 const int label = f >= 0 ? f : coarse[(x >> 3) + coarse_x * ((y >> 3) + coarse_y * size_t(z >> 3))];
                 v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = T(10 * label);
             }
+    return v;
+}
+
+/// Labels 0, 10, 20, 30 in uniform blocks of every side from 32 down to 4, as in an atlas with
+/// large regions: each 32^3 block, drawn from `seed`, is one label with probability 2/5, else its
+/// eight halves are drawn the same way, down to 4^3 blocks that are always uniform. Their trees
+/// hold scalar leaves of side 4 to 32 whose shell cells meet neighbours of every label and side.
+template <typename T> DenseVolume<T> nested_label_blocks(Dims dims, uint32_t seed) {
+    DenseVolume<T> v{dims, std::vector<T>(dims.voxels())};
+    std::mt19937 rng(seed);
+    const std::function<void(uint32_t, uint32_t, uint32_t, uint32_t)> fill = [&](uint32_t x0, uint32_t y0, uint32_t z0,
+                                                                                  uint32_t side) {
+        if (side > 4 && rng() % 5u >= 2u) {
+            const uint32_t h = side / 2;
+            for (int c = 0; c < 8; ++c) fill(x0 + ((c & 4) ? h : 0), y0 + ((c & 2) ? h : 0), z0 + ((c & 1) ? h : 0), h);
+            return;
+        }
+        const T label = T(10 * (rng() % 4u));
+        for (uint32_t z = z0; z < std::min(z0 + side, dims.z); ++z)
+            for (uint32_t y = y0; y < std::min(y0 + side, dims.y); ++y)
+                for (uint32_t x = x0; x < std::min(x0 + side, dims.x); ++x) v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = label;
+    };
+    for (uint32_t z = 0; z < dims.z; z += 32)
+        for (uint32_t y = 0; y < dims.y; y += 32)
+            for (uint32_t x = 0; x < dims.x; x += 32) fill(x, y, z, 32);
     return v;
 }
 

@@ -5,6 +5,7 @@
 // bit-identical across Traversal::single/packets x Isa::baseline/avx2 x Embree on/off.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -191,6 +192,51 @@ TEST(PacketTraversal, SideFourLeavesAsCapParentsEqualTheLeafWalk) {
         single.isovalues = isos;
         for (double azimuth : {30.0, 130.0, 215.0, 300.0}) {
             const Camera camera = orbit_camera(dims, Placement{}, 120, 104, azimuth, azimuth > 180 ? -25.0 : 35.0, 1.0);
+            const Frame reference = render(data.view(), Placement{}, camera, single);
+            ASSERT_GT(reference.stats.hits, 3000u);
+            for (Isa isa : isas) {
+                RenderOptions o = single;
+                o.traversal = Traversal::packets, o.isa = isa;
+                const Frame f = render(data.view(), Placement{}, camera, o);
+                const std::string what = "iso " + std::to_string(isos[0]) + ", azimuth " + std::to_string(azimuth) + ", isa " +
+                                         std::to_string(int(isa));
+                EXPECT_EQ(0, std::memcmp(f.depth.data(), reference.depth.data(), f.depth.size() * sizeof(float))) << what;
+                EXPECT_EQ(0, std::memcmp(f.normal.data(), reference.normal.data(), f.normal.size() * sizeof(float))) << what;
+            }
+        }
+    }
+}
+
+/// Scalar leaves of side 8 to 32, which a packet reaches from the beam (beam_node) and walks lane
+/// by lane, and which any packet path for them must cross exactly as the single ray's leaf walk:
+/// labels in uniform blocks of sides 4 to 32, isovalues between the labels and equal to them
+/// (then every cell of a leaf is walked), views from four octants, and every frame of packets on
+/// both kernels must equal the single-ray frame bit for bit. (It failed, as it should, on a
+/// packet path that skipped the shell blocks of these leaves; BENCHMARKS.md, packets, stop 47.)
+TEST(PacketTraversal, LeavesOfSideEightToThirtyTwoEqualTheSingleRayLeafWalk) {
+    const Dims dims{90, 77, 85};   // a cube of 128, its last blocks cut by the data box
+    const DenseVolume<uint8_t> v = nested_label_blocks<uint8_t>(dims, 5);
+    const OctreeData<uint8_t> data = build_octree(v.view(), {});
+    const Octree<uint8_t> tree = data.view();
+    // The premise: the path under test has leaves of every side to walk.
+    for (uint32_t side : {8u, 16u, 32u}) {
+        const int d = tree.dmax() - std::countr_zero(side) - 1;
+        uint64_t leaves = 0;
+        for (uint64_t i = 0; i < tree.node_count(d); ++i)
+            for (int c = 0; c < 8; ++c) leaves += tree.node(d, i).is_scalar_leaf(c);
+        ASSERT_GT(leaves, 8u) << "side " << side;
+    }
+    std::vector<Isa> isas{Isa::baseline};
+    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    RenderOptions single;
+    single.want_depth = single.want_normal = true;
+    single.traversal = Traversal::single;
+    single.isa = Isa::baseline;
+    single.use_embree = false;
+    for (const std::vector<double>& isos : {std::vector<double>{15.0}, std::vector<double>{10.0}, std::vector<double>{20.0, 5.0}}) {
+        single.isovalues = isos;
+        for (double azimuth : {30.0, 130.0, 215.0, 300.0}) {
+            const Camera camera = orbit_camera(dims, Placement{}, 128, 112, azimuth, azimuth > 180 ? -25.0 : 35.0, 1.0);
             const Frame reference = render(data.view(), Placement{}, camera, single);
             ASSERT_GT(reference.stats.hits, 3000u);
             for (Isa isa : isas) {
