@@ -165,22 +165,19 @@ TEST(PacketTraversal, CloseUpFramesWhosePacketsShareCapsAreIdentical) {
     }
 }
 
-/// Scalar leaves of side 4 (children of the nodes at depth dmax-3) are crossed by a packet as cap
-/// parents of constant caps (OctreeTracer::packet_leaf_cap_parent), by a single ray with the leaf
-/// walk (scalar_leaf): labels in uniform 4^3 and 8^3 blocks, isovalues between the labels and equal
-/// to them (then the cap at the leaf's origin, whose corners all lie inside the leaf, is walked
-/// too), views from four octants, and every frame of packets on both kernels must equal the
-/// single-ray frame bit for bit.
-TEST(PacketTraversal, SideFourLeavesAsCapParentsEqualTheLeafWalk) {
-    const Dims dims{45, 38, 41};
-    const DenseVolume<uint8_t> v = label_blocks<uint8_t>(dims, 3);
-    const OctreeData<uint8_t> data = build_octree(v.view(), {});
-    const Octree<uint8_t> tree = data.view();
-    uint64_t side_four_leaves = 0;   // the premise: the path under test has leaves to walk
-    const int d = tree.dmax() - 3;
+/// The scalar leaves of `side` in `tree` (children of the nodes at depth dmax - log2(side) - 1).
+uint64_t scalar_leaves_of_side(const Octree<uint8_t>& tree, uint32_t side) {
+    const int d = tree.dmax() - std::countr_zero(side) - 1;
+    uint64_t leaves = 0;
     for (uint64_t i = 0; i < tree.node_count(d); ++i)
-        for (int c = 0; c < 8; ++c) side_four_leaves += tree.node(d, i).is_scalar_leaf(c);
-    ASSERT_GT(side_four_leaves, 100u);
+        for (int c = 0; c < 8; ++c) leaves += tree.node(d, i).is_scalar_leaf(c);
+    return leaves;
+}
+
+/// A label volume (labels 0, 10, 20, 30) seen from four octants at width x height, with
+/// isovalues between the labels and equal to them (then every cell of a leaf is walked): every
+/// frame of packets on both kernels must equal the single-ray frame bit for bit.
+void expect_label_views_of_packets_equal_single_rays(const Octree<uint8_t>& tree, Dims dims, int width, int height) {
     std::vector<Isa> isas{Isa::baseline};
     if (cpu_has_avx2()) isas.push_back(Isa::avx2);
     RenderOptions single;
@@ -191,13 +188,13 @@ TEST(PacketTraversal, SideFourLeavesAsCapParentsEqualTheLeafWalk) {
     for (const std::vector<double>& isos : {std::vector<double>{15.0}, std::vector<double>{10.0}, std::vector<double>{20.0, 5.0}}) {
         single.isovalues = isos;
         for (double azimuth : {30.0, 130.0, 215.0, 300.0}) {
-            const Camera camera = orbit_camera(dims, Placement{}, 120, 104, azimuth, azimuth > 180 ? -25.0 : 35.0, 1.0);
-            const Frame reference = render(data.view(), Placement{}, camera, single);
+            const Camera camera = orbit_camera(dims, Placement{}, width, height, azimuth, azimuth > 180 ? -25.0 : 35.0, 1.0);
+            const Frame reference = render(tree, Placement{}, camera, single);
             ASSERT_GT(reference.stats.hits, 3000u);
             for (Isa isa : isas) {
                 RenderOptions o = single;
                 o.traversal = Traversal::packets, o.isa = isa;
-                const Frame f = render(data.view(), Placement{}, camera, o);
+                const Frame f = render(tree, Placement{}, camera, o);
                 const std::string what = "iso " + std::to_string(isos[0]) + ", azimuth " + std::to_string(azimuth) + ", isa " +
                                          std::to_string(int(isa));
                 EXPECT_EQ(0, std::memcmp(f.depth.data(), reference.depth.data(), f.depth.size() * sizeof(float))) << what;
@@ -207,49 +204,28 @@ TEST(PacketTraversal, SideFourLeavesAsCapParentsEqualTheLeafWalk) {
     }
 }
 
+/// Scalar leaves of side 4 (children of the nodes at depth dmax-3) are crossed by a packet as cap
+/// parents of constant caps (OctreeTracer::packet_leaf_cap_parent), by a single ray with the leaf
+/// walk (scalar_leaf): labels in uniform 4^3 and 8^3 blocks; with an isovalue equal to a label
+/// the cap at the leaf's origin, whose corners all lie inside the leaf, is walked too.
+TEST(PacketTraversal, SideFourLeavesAsCapParentsEqualTheLeafWalk) {
+    const Dims dims{45, 38, 41};
+    const DenseVolume<uint8_t> v = label_blocks<uint8_t>(dims, 3);
+    const OctreeData<uint8_t> data = build_octree(v.view(), {});
+    ASSERT_GT(scalar_leaves_of_side(data.view(), 4), 100u);   // the premise: the path under test has leaves to walk
+    expect_label_views_of_packets_equal_single_rays(data.view(), dims, 120, 104);
+}
+
 /// Scalar leaves of side 8 to 32, which a packet reaches from the beam (beam_node) and walks lane
 /// by lane, and which any packet path for them must cross exactly as the single ray's leaf walk:
-/// labels in uniform blocks of sides 4 to 32, isovalues between the labels and equal to them
-/// (then every cell of a leaf is walked), views from four octants, and every frame of packets on
-/// both kernels must equal the single-ray frame bit for bit. (It failed, as it should, on a
-/// packet path that skipped the shell blocks of these leaves; BENCHMARKS.md, packets, stop 47.)
+/// labels in uniform blocks of sides 4 to 32. (It failed, as it should, on a packet path that
+/// skipped the shell blocks of these leaves; BENCHMARKS.md, packets, stop 47.)
 TEST(PacketTraversal, LeavesOfSideEightToThirtyTwoEqualTheSingleRayLeafWalk) {
     const Dims dims{90, 77, 85};   // a cube of 128, its last blocks cut by the data box
     const DenseVolume<uint8_t> v = nested_label_blocks<uint8_t>(dims, 5);
     const OctreeData<uint8_t> data = build_octree(v.view(), {});
-    const Octree<uint8_t> tree = data.view();
-    // The premise: the path under test has leaves of every side to walk.
-    for (uint32_t side : {8u, 16u, 32u}) {
-        const int d = tree.dmax() - std::countr_zero(side) - 1;
-        uint64_t leaves = 0;
-        for (uint64_t i = 0; i < tree.node_count(d); ++i)
-            for (int c = 0; c < 8; ++c) leaves += tree.node(d, i).is_scalar_leaf(c);
-        ASSERT_GT(leaves, 8u) << "side " << side;
-    }
-    std::vector<Isa> isas{Isa::baseline};
-    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
-    RenderOptions single;
-    single.want_depth = single.want_normal = true;
-    single.traversal = Traversal::single;
-    single.isa = Isa::baseline;
-    single.use_embree = false;
-    for (const std::vector<double>& isos : {std::vector<double>{15.0}, std::vector<double>{10.0}, std::vector<double>{20.0, 5.0}}) {
-        single.isovalues = isos;
-        for (double azimuth : {30.0, 130.0, 215.0, 300.0}) {
-            const Camera camera = orbit_camera(dims, Placement{}, 128, 112, azimuth, azimuth > 180 ? -25.0 : 35.0, 1.0);
-            const Frame reference = render(data.view(), Placement{}, camera, single);
-            ASSERT_GT(reference.stats.hits, 3000u);
-            for (Isa isa : isas) {
-                RenderOptions o = single;
-                o.traversal = Traversal::packets, o.isa = isa;
-                const Frame f = render(data.view(), Placement{}, camera, o);
-                const std::string what = "iso " + std::to_string(isos[0]) + ", azimuth " + std::to_string(azimuth) + ", isa " +
-                                         std::to_string(int(isa));
-                EXPECT_EQ(0, std::memcmp(f.depth.data(), reference.depth.data(), f.depth.size() * sizeof(float))) << what;
-                EXPECT_EQ(0, std::memcmp(f.normal.data(), reference.normal.data(), f.normal.size() * sizeof(float))) << what;
-            }
-        }
-    }
+    for (uint32_t side : {8u, 16u, 32u}) ASSERT_GT(scalar_leaves_of_side(data.view(), side), 8u) << "side " << side;
+    expect_label_views_of_packets_equal_single_rays(data.view(), dims, 128, 112);
 }
 
 /// The beam (OctreeTracer::beam_node: packets of rays from one origin cross the upper levels as
