@@ -89,7 +89,7 @@ template <typename T> DenseVolume<T> nested_label_blocks(Dims dims, uint32_t see
         const T label = T(10 * (rng() % 4u));
         for (uint32_t z = z0; z < std::min(z0 + side, dims.z); ++z)
             for (uint32_t y = y0; y < std::min(y0 + side, dims.y); ++y)
-                for (uint32_t x = x0; x < std::min(x0 + side, dims.x); ++x) v.values[x + size_t(dims.x) * (y + size_t(dims.y) * z)] = label;
+                for (uint32_t x = x0; x < std::min(x0 + side, dims.x); ++x) v.values[v.view().index(x, y, z)] = label;
     };
     for (uint32_t z = 0; z < dims.z; z += 32)
         for (uint32_t y = 0; y < dims.y; y += 32)

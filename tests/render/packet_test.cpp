@@ -177,7 +177,7 @@ uint64_t scalar_leaves_of_side(const Octree<uint8_t>& tree, uint32_t side) {
 /// A label volume (labels 0, 10, 20, 30) seen from four octants at width x height, with
 /// isovalues between the labels and equal to them (then every cell of a leaf is walked): every
 /// frame of packets on both kernels must equal the single-ray frame bit for bit.
-void expect_label_views_of_packets_equal_single_rays(const Octree<uint8_t>& tree, Dims dims, int width, int height) {
+void expect_label_views_of_packets_equal_single_rays(const Octree<uint8_t>& tree, int width, int height) {
     std::vector<Isa> isas{Isa::baseline};
     if (cpu_has_avx2()) isas.push_back(Isa::avx2);
     RenderOptions single;
@@ -188,7 +188,7 @@ void expect_label_views_of_packets_equal_single_rays(const Octree<uint8_t>& tree
     for (const std::vector<double>& isos : {std::vector<double>{15.0}, std::vector<double>{10.0}, std::vector<double>{20.0, 5.0}}) {
         single.isovalues = isos;
         for (double azimuth : {30.0, 130.0, 215.0, 300.0}) {
-            const Camera camera = orbit_camera(dims, Placement{}, width, height, azimuth, azimuth > 180 ? -25.0 : 35.0, 1.0);
+            const Camera camera = orbit_camera(tree.dims(), Placement{}, width, height, azimuth, azimuth > 180 ? -25.0 : 35.0, 1.0);
             const Frame reference = render(tree, Placement{}, camera, single);
             ASSERT_GT(reference.stats.hits, 3000u);
             for (Isa isa : isas) {
@@ -213,7 +213,7 @@ TEST(PacketTraversal, SideFourLeavesAsCapParentsEqualTheLeafWalk) {
     const DenseVolume<uint8_t> v = label_blocks<uint8_t>(dims, 3);
     const OctreeData<uint8_t> data = build_octree(v.view(), {});
     ASSERT_GT(scalar_leaves_of_side(data.view(), 4), 100u);   // the premise: the path under test has leaves to walk
-    expect_label_views_of_packets_equal_single_rays(data.view(), dims, 120, 104);
+    expect_label_views_of_packets_equal_single_rays(data.view(), 120, 104);
 }
 
 /// Scalar leaves of side 8 to 32, which a packet reaches from the beam (beam_node) and walks lane
@@ -225,7 +225,7 @@ TEST(PacketTraversal, LeavesOfSideEightToThirtyTwoEqualTheSingleRayLeafWalk) {
     const DenseVolume<uint8_t> v = nested_label_blocks<uint8_t>(dims, 5);
     const OctreeData<uint8_t> data = build_octree(v.view(), {});
     for (uint32_t side : {8u, 16u, 32u}) ASSERT_GT(scalar_leaves_of_side(data.view(), side), 8u) << "side " << side;
-    expect_label_views_of_packets_equal_single_rays(data.view(), dims, 128, 112);
+    expect_label_views_of_packets_equal_single_rays(data.view(), 128, 112);
 }
 
 /// The beam (OctreeTracer::beam_node: packets of rays from one origin cross the upper levels as
