@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "octiso/inline.h"
 #include "octiso/octree.h"
@@ -57,13 +59,25 @@ struct CellWalkScene {
     }
 };
 
+/// A first hit whose cell, isovalue and root bracket are decided, its root not yet refined
+/// (nearest_root with kDefer): what the rest of nearest_root needs, kept until finish_hit.
+struct PendingHit {
+    RootBracket bracket;
+    double t_in, t_out;
+    std::array<double, 3> p_in, p_out, cell_spacing;
+    double corner[8];
+};
+
 /// Per-ray state of a cell walk: the index-space ray, where it leaves the data, and the hit so far.
 struct RayState {
     IndexRay ray;
     std::array<double, 3> world_dir{};
     double t_exit = 0;
     bool want_normal = false;
+    /// hit.iso_index is set, hit.t and hit.normal wait for finish_hit (pending_roots.h).
+    bool pending = false;
     TraceHit hit;
+    PendingHit later;
 
     /// Starts `ray_world` in `scene`: returns the piece of its interval [t_min, t_max] inside the
     /// data box, empty on a miss.
@@ -78,13 +92,50 @@ struct RayState {
     }
 };
 
+/// The hit at s of the segment p_in -> p_out (the ray piece [t_in, t_out)): its t and, if wanted,
+/// its normal (gradient per world unit through `cell_spacing`).
+OCTISO_ALWAYS_INLINE void set_hit_at(RayState& w, double s, const double corner[8], const std::array<double, 3>& p_in,
+                                     const std::array<double, 3>& p_out, double t_in, double t_out,
+                                     const std::array<double, 3>& cell_spacing) {
+    w.hit.t = t_in + s * (t_out - t_in);
+    if (w.want_normal) {
+        std::array<double, 3> p_hit;
+        for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + s * (p_out[a] - p_in[a]);
+        w.hit.normal = world_normal(corner, p_hit, cell_spacing, w.world_dir);
+    }
+}
+
 /// The nearest root of the isovalues inside [lo, hi] (the corners' range) on the cell-local
 /// segment p_in -> p_out, which is the ray piece [t_in, t_out): fills `w.hit` (the normal's
 /// gradient per world unit through `cell_spacing`) and returns true, or false with no root.
-template <class Finder>
+/// kDefer (Neubauer, one isovalue): a root that needs refining is a hit all the same (its s lies
+/// in its bracket, inside [0, 1)), so its refinement, t and normal can wait: `w.later` keeps what
+/// they need, w.pending is set, and finish_hit (pending_roots.h) later gives the same hit bit
+/// for bit. A packet then refines its lanes' roots four at a time.
+template <class Finder, bool kDefer = false>
 inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RayState& w, const double corner[8], double lo, double hi,
                          const std::array<double, 3>& p_in, const std::array<double, 3>& p_out, double t_in, double t_out,
                          bool closed_end, const std::array<double, 3>& cell_spacing) {
+    if constexpr (kDefer && std::is_same_v<Finder, Neubauer>) {
+        if (scene.iso_count == 1) {
+            // The loop below for its one isovalue.
+            const double iso = scene.isovalues[0];
+            if (!(lo <= iso && iso <= hi)) return false;
+            const double s = first_root(finder, corner, iso, p_in, p_out, closed_end, &w.later.bracket);
+            if (s == kRootPending) {
+                w.pending = true;
+                w.hit.iso_index = 0;
+                PendingHit& h = w.later;
+                h.t_in = t_in, h.t_out = t_out, h.p_in = p_in, h.p_out = p_out, h.cell_spacing = cell_spacing;
+                std::memcpy(h.corner, corner, sizeof h.corner);
+                return true;
+            }
+            if (!(s >= 0)) return false;
+            w.hit.iso_index = 0;
+            set_hit_at(w, s, corner, p_in, p_out, t_in, t_out, cell_spacing);
+            return true;
+        }
+    }
     double best_s = 2.0;
     int best = -1;
     for (int i = 0; i < scene.iso_count; ++i) {
@@ -94,13 +145,8 @@ inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RaySt
         if (s >= 0 && s < best_s) best_s = s, best = i;
     }
     if (best < 0) return false;
-    w.hit.t = t_in + best_s * (t_out - t_in);
     w.hit.iso_index = best;
-    if (w.want_normal) {
-        std::array<double, 3> p_hit;
-        for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + best_s * (p_out[a] - p_in[a]);
-        w.hit.normal = world_normal(corner, p_hit, cell_spacing, w.world_dir);
-    }
+    set_hit_at(w, best_s, corner, p_in, p_out, t_in, t_out, cell_spacing);
     return true;
 }
 
@@ -112,7 +158,7 @@ OCTISO_ALWAYS_INLINE void corner_range(const double corner[8], double& lo, doubl
 
 /// intersect_cell after its cull, for a caller that has the corners' range [lo, hi] already (a
 /// packet's cell, culled once for all its lanes): the same root, bit for bit.
-template <class Finder>
+template <class Finder, bool kDefer = false>
 OCTISO_ALWAYS_INLINE bool intersect_cell_in_range(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
                                                   const double corner[8], double lo, double hi, double t_in, double t_out,
                                                   bool closed_end) {
@@ -126,18 +172,19 @@ OCTISO_ALWAYS_INLINE bool intersect_cell_in_range(const Finder& finder, const Ce
         p_in[a] = snap_to_face(o_cell[a] + t_in * r.dir[a]);
         p_out[a] = snap_to_face(o_cell[a] + t_out * r.dir[a]);
     }
-    return nearest_root(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end, scene.placement.spacing);
+    return nearest_root<Finder, kDefer>(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end,
+                                        scene.placement.spacing);
 }
 
 /// Tests cell v (lower corner, index space) with corners `corner` (order i + 2j + 4k) on the ray
 /// piece [t_in, t_out) ([t_in, t_out] when closed_end). On a hit fills `w.hit` and returns true.
-template <class Finder>
+template <class Finder, bool kDefer = false>
 inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
                            const double corner[8], double t_in, double t_out, bool closed_end) {
     double lo, hi;
     corner_range(corner, lo, hi);
     if (!scene.any_iso_in(lo, hi)) return false;   // a NaN corner fails every comparison
-    return intersect_cell_in_range(finder, scene, w, v, corner, lo, hi, t_in, t_out, closed_end);
+    return intersect_cell_in_range<Finder, kDefer>(finder, scene, w, v, corner, lo, hi, t_in, t_out, closed_end);
 }
 
 /// Level of detail (lod.h): intersect_cell on the coarse cell with lower corner v and sides
@@ -145,7 +192,7 @@ inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, Ray
 /// 8 vertices. The segment is mapped into the unit cube by dividing by the extent, and the
 /// normal's gradient is per world unit through spacing x extent. A separate function so that the
 /// exact path keeps its arithmetic bit for bit.
-template <class Finder>
+template <class Finder, bool kDefer = false>
 inline bool intersect_coarse_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
                                   const uint32_t extent[3], const double corner[8], double t_in, double t_out,
                                   bool closed_end) {
@@ -162,7 +209,7 @@ inline bool intersect_coarse_cell(const Finder& finder, const CellWalkScene& sce
         p_out[a] = snap_to_face((o + t_out * r.dir[a]) / e);
         cell_spacing[a] = scene.placement.spacing[a] * e;
     }
-    return nearest_root(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end, cell_spacing);
+    return nearest_root<Finder, kDefer>(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end, cell_spacing);
 }
 
 OCTISO_ISA_END

@@ -8,7 +8,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
+#include "octiso/inline.h"
 #include "octiso/root_finder.h"
 #include "render/cell.h"
 #include "util/isa.h"
@@ -18,6 +20,18 @@ OCTISO_ISA_BEGIN
 
 /// first_root's "no hit": negative, never NaN.
 inline constexpr double kNoHit = -1.0;
+/// first_root's "a root is located, its refinement left to the caller" (only where it is given
+/// a RootBracket): negative, never NaN, not kNoHit.
+inline constexpr double kRootPending = -2.0;
+
+/// A root located but not refined: the monotone piece [a, b] of the cubic with coefficients c
+/// that holds it, f(a) = fa and f(b) = fb nonzero with opposite signs. Neubauer::refine on it and
+/// roots_detail::into_bracket(s, a, b) give first_root's s bit for bit (pending_roots.h refines
+/// four at a time).
+struct RootBracket {
+    double c[4];
+    double a, fa, b, fb;
+};
 
 namespace roots_detail {
 
@@ -283,23 +297,33 @@ struct Exact {
 /// (f_in != 0, a segment of non-zero length): the first piece with a sign change holds exactly one
 /// root, the first root. Signs are compared, never multiplied (E12). first_root without its
 /// early exit (roots_detail::keeps_one_sign), which a test holds to the same results.
+/// With `later` (Neubauer only), a root that needs refining is not refined: its bracket goes to
+/// *later and the walk returns kRootPending.
 template <class Finder>
-inline double marmitt_walk(const Finder& finder, const CellCubic<typename Finder::Real>& f, bool closed_end) {
+inline double marmitt_walk(const Finder& finder, const CellCubic<typename Finder::Real>& f, bool closed_end,
+                           RootBracket* later = nullptr) {
     using R = typename Finder::Real;
     using roots_detail::sign;
+    const auto refined = [&](R a, R fa, R b, R fb) OCTISO_LAMBDA_INLINE {
+        if constexpr (std::is_same_v<Finder, Neubauer>) {
+            if (later) {
+                *later = {{f.c[0], f.c[1], f.c[2], f.c[3]}, a, fa, b, fb};
+                return kRootPending;
+            }
+        }
+        return roots_detail::into_bracket(double(finder.refine(f, a, fa, b, fb)), double(a), double(b));
+    };
     R ext[2];
     const int n = finder.extrema(f, ext);
     R a = 0, fa = f.f_in;
     for (int i = 0; i < n; ++i) {
         const R e = ext[i], fe = f(e);
         if (fe == 0) return roots_detail::into_bracket(double(e), 0.0, 1.0);
-        if (sign(fe) != sign(fa))
-            return roots_detail::into_bracket(double(finder.refine(f, a, fa, e, fe)), double(a), double(e));
+        if (sign(fe) != sign(fa)) return refined(a, fa, e, fe);
         a = e, fa = fe;
     }
     if (f.f_out == 0) return closed_end ? 1.0 : kNoHit;
-    if (sign(f.f_out) != sign(fa))
-        return roots_detail::into_bracket(double(finder.refine(f, a, fa, R(1), f.f_out)), double(a), 1.0);
+    if (sign(f.f_out) != sign(fa)) return refined(a, fa, R(1), f.f_out);
     return kNoHit;
 }
 
@@ -315,9 +339,10 @@ inline double marmitt_walk(const Finder& finder, const CellCubic<typename Finder
 ///     that does not reach iso is not;
 ///   - a root exactly at s = 1 (f_out == 0) belongs to the next cell unless closed_end.
 /// Pure function of its arguments; thread-safe.
+/// With `later` (Neubauer only): kRootPending where the root needs refining, its bracket in *later.
 template <class Finder>
 inline double first_root(const Finder& finder, const double corner[8], double iso, const std::array<double, 3>& p_in,
-                         const std::array<double, 3>& p_out, bool closed_end) {
+                         const std::array<double, 3>& p_out, bool closed_end, RootBracket* later = nullptr) {
     using R = typename Finder::Real;
     bool finite = std::isfinite(iso);
     for (int i = 0; i < 8; ++i) finite &= std::isfinite(corner[i]);
@@ -329,7 +354,7 @@ inline double first_root(const Finder& finder, const double corner[8], double is
     if (f.f_in == 0) return 0.0;
     // 0.94-0.96 x the frame time (min of 5 interleaved pairs; build_ab_bernstein_exit.json).
     if (roots_detail::keeps_one_sign(f)) return kNoHit;
-    return marmitt_walk(finder, f, closed_end);
+    return marmitt_walk(finder, f, closed_end, later);
 }
 
 /// Calls f(finder) with a value of the policy type for `kind`, once, outside the hot loop, so

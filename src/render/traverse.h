@@ -42,6 +42,7 @@
 #include "render/lod.h"
 #include "render/packet_size.h"
 #include "render/packet_start.h"
+#include "render/pending_roots.h"
 #include "render/simd4.h"
 #include "math/ray.h"
 #include "render/roots.h"
@@ -97,8 +98,18 @@ public:
         const BoxClip clip = w.start(scene_, ray_world, want_normal);
         if constexpr (Recorder::kOn) recorder_.clip(clip.t_in, clip.t_out);
         if (!clip.empty()) node(w, 0, 0, Coord{}, clip.t_in, clip.t_out);
+        if (w.pending) finish_hit(finder_, w);
         return w.hit;
     }
+
+    /// Roots that need refining are refined when the trace ends (nearest_root's kDefer,
+    /// pending_roots.h): a packet's four at a time, with their normals. Not with the recorder,
+    /// which reports each root as it is found. scripts/build_ab.py against 7581811, 512^2, 1
+    /// thread, 15 pairs: 0.94-0.97 x the trace at the minimum on ch2better @100.5 and @25.5 and ch2
+    /// @100.5, 1.03 on aal (medians 0.88-0.96; build_ab_deferred_refine_normal.json); the
+    /// refinement alone, normals one by one, 0.99-1.01 x at the minimum in a 21-pair run
+    /// (build_ab_deferred_refine_only.json): the normals' divisions and square root are the gain.
+    static constexpr bool kDeferRoots = !Recorder::kOn;
 
     /// The most rays one trace_packet() call takes (packet_size.h).
     static constexpr int kMaxPacket = kMaxTracePacket;
@@ -190,6 +201,9 @@ public:
             else
                 packet_node(p, 0, 0, Coord{}, lanes, flip, p.t0, p.t1);
         }
+        unsigned pending = 0;
+        for (int k = 0; k < count; ++k) pending |= unsigned(p.lane[k].pending) << k;
+        if (pending) finish_hits(finder_, p.lane, pending);
         for (int k = 0; k < count; ++k) hits[k] = p.lane[k].hit;
     }
 
@@ -723,7 +737,8 @@ private:
             for (unsigned m = entered; m; m &= m - 1) {
                 const int k = std::countr_zero(m);
                 Walk& w = p.lane[k];
-                if (intersect_cell_in_range(finder_, scene_, w, v, corner, lo, hi, c0[k], c1[k], c1[k] == w.t_exit))
+                if (intersect_cell_in_range<Finder, kDeferRoots>(finder_, scene_, w, v, corner, lo, hi, c0[k], c1[k],
+                                                                 c1[k] == w.t_exit))
                     active &= ~(1u << k);
             }
         }
@@ -1143,7 +1158,7 @@ private:
         const bool closed_end = t1 == w.t_exit;
         if (!(t1 > t0 || closed_end)) return false;
         const uint32_t extent[3] = {side, side, side};
-        if (!intersect_coarse_cell(finder_, scene_, w, co, extent, corner, t0, t1, closed_end)) return false;
+        if (!intersect_coarse_cell<Finder, kDeferRoots>(finder_, scene_, w, co, extent, corner, t0, t1, closed_end)) return false;
         w.hit.cell_log2 = std::countr_zero(side);
         return true;
     }
@@ -1211,7 +1226,7 @@ private:
                                   corner[k] = double(tree_.lattice_value(co, p, at, d, trace));
                               }
                               const Coord v{q[0], q[1], q[2]};
-                              if (!intersect_coarse_cell(finder_, scene_, w, v, e, corner, t_in, t_out, closed_end))
+                              if (!intersect_coarse_cell<Finder, kDeferRoots>(finder_, scene_, w, v, e, corner, t_in, t_out, closed_end))
                                   return false;
                               w.hit.cell_log2 = shift;
                               return true;
@@ -1238,7 +1253,7 @@ private:
             if (hit) recorder_.root(w.hit.t, w.hit.iso_index);
             return hit;
         }
-        return intersect_cell(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
+        return intersect_cell<Finder, kDeferRoots>(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
     }
 
     const Octree<T> tree_;   // a view: cheap to copy, and no dangling reference to a temporary
