@@ -18,7 +18,7 @@ LAYERS = [
     ("octree", ["include/octiso/octree.h", "include/octiso/build.h", "include/octiso/decode.h", "src/octree/"]),
     ("format", ["include/octiso/oct_file.h", "include/octiso/verify.h", "src/format/"]),
     ("kernels", ["src/render/cell.h", "src/render/roots.h", "src/render/cell_hit.h", "src/render/cell_dda.h",
-                 "src/render/lod.h", "src/render/live_children.h", "src/render/packet_size.h", "src/render/packet_start.h", "src/render/simd4.h",
+                 "src/render/lod.h", "src/render/live_children.h", "src/render/packet_size.h", "src/render/packet_start.h", "src/render/pending_roots.h", "src/render/simd4.h",
                  "src/render/traverse.h",
                  "src/render/root_finder.cpp"]),
     ("scene", ["src/scene/"]),

@@ -3,7 +3,9 @@
 // hands over, so no template of the test's own is instantiated with AVX2 code.
 #include "render/pending_roots.h"
 
-namespace octiso::test {
+namespace octiso {
+OCTISO_ISA_BEGIN   // isa_avx2: AVX code only under that name (scripts/check_isa.py)
+namespace test {
 
 /// neubauer_refine4 on four brackets: in[j][lane] for j = c0, c1, c2, c3, a, fa, b, fb.
 void refine4_for_test(int iterations, const double in[8][4], double out[4]) {
@@ -22,4 +24,6 @@ void normal4_for_test(const double in[17][4], double out[3][4], long long ok[4])
     for (int i = 0; i < 4; ++i) ok[i] = done[i];
 }
 
-}  // namespace octiso::test
+}  // namespace test
+OCTISO_ISA_END
+}  // namespace octiso

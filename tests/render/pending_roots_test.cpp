@@ -18,8 +18,7 @@
 #include "test_util/skip.h"
 
 namespace octiso {
-namespace test {
-// pending_roots_avx2.cpp
+namespace isa_avx2::test {   // pending_roots_avx2.cpp, compiled for AVX2
 void refine4_for_test(int iterations, const double in[8][4], double out[4]);
 void normal4_for_test(const double in[17][4], double out[3][4], long long ok[4]);
 }
@@ -137,7 +136,7 @@ TEST(PendingRoots, FourAtATimeInAvx2EqualsTheScalarRefinementLaneByLane) {
                 const double part[8] = {r.c[0], r.c[1], r.c[2], r.c[3], r.a, r.fa, r.b, r.fb};
                 for (int j = 0; j < 8; ++j) in[j][l] = part[j];
             }
-            test::refine4_for_test(iterations, in, out);
+            isa_avx2::test::refine4_for_test(iterations, in, out);
             for (int l = 0; l < 4; ++l) {
                 const Bracket& r = brackets[(i + l) % brackets.size()];
                 CellCubic<double> f{};
@@ -189,7 +188,7 @@ TEST(PendingRoots, NormalsFourAtATimeInAvx2EqualWorldNormalOrDeferToIt) {
             for (int a = 0; a < 3; ++a) in[a][l] = h.p[a], in[11 + a][l] = h.spacing[a], in[14 + a][l] = h.dir[a];
             for (int j = 0; j < 8; ++j) in[3 + j][l] = h.corner[j];
         }
-        test::normal4_for_test(in, out, ok);
+        isa_avx2::test::normal4_for_test(in, out, ok);
         for (int l = 0; l < 4; ++l) {
             const NormalCase& h = cases[(i + l) % cases.size()];
             const P3 scalar = world_normal(h.corner, {h.p[0], h.p[1], h.p[2]}, {h.spacing[0], h.spacing[1], h.spacing[2]},
