@@ -92,17 +92,21 @@ struct RayState {
     }
 };
 
+/// The ray's t at s of its piece [t_in, t_out), and the cell-local point at s of the segment
+/// p_in -> p_out: a hit's place, here and in finish_hits (pending_roots.h), the same arithmetic.
+OCTISO_ALWAYS_INLINE double piece_t(double t_in, double t_out, double s) { return t_in + s * (t_out - t_in); }
+OCTISO_ALWAYS_INLINE std::array<double, 3> segment_point(const std::array<double, 3>& p_in,
+                                                         const std::array<double, 3>& p_out, double s) {
+    return {p_in[0] + s * (p_out[0] - p_in[0]), p_in[1] + s * (p_out[1] - p_in[1]), p_in[2] + s * (p_out[2] - p_in[2])};
+}
+
 /// The hit at s of the segment p_in -> p_out (the ray piece [t_in, t_out)): its t and, if wanted,
 /// its normal (gradient per world unit through `cell_spacing`).
 OCTISO_ALWAYS_INLINE void set_hit_at(RayState& w, double s, const double corner[8], const std::array<double, 3>& p_in,
                                      const std::array<double, 3>& p_out, double t_in, double t_out,
                                      const std::array<double, 3>& cell_spacing) {
-    w.hit.t = t_in + s * (t_out - t_in);
-    if (w.want_normal) {
-        std::array<double, 3> p_hit;
-        for (int a = 0; a < 3; ++a) p_hit[a] = p_in[a] + s * (p_out[a] - p_in[a]);
-        w.hit.normal = world_normal(corner, p_hit, cell_spacing, w.world_dir);
-    }
+    w.hit.t = piece_t(t_in, t_out, s);
+    if (w.want_normal) w.hit.normal = world_normal(corner, segment_point(p_in, p_out, s), cell_spacing, w.world_dir);
 }
 
 /// The nearest root of the isovalues inside [lo, hi] (the corners' range) on the cell-local
@@ -116,32 +120,24 @@ template <class Finder, bool kDefer = false>
 inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RayState& w, const double corner[8], double lo, double hi,
                          const std::array<double, 3>& p_in, const std::array<double, 3>& p_out, double t_in, double t_out,
                          bool closed_end, const std::array<double, 3>& cell_spacing) {
-    if constexpr (kDefer && std::is_same_v<Finder, Neubauer>) {
-        if (scene.iso_count == 1) {
-            // The loop below for its one isovalue.
-            const double iso = scene.isovalues[0];
-            if (!(lo <= iso && iso <= hi)) return false;
-            const double s = first_root(finder, corner, iso, p_in, p_out, closed_end, &w.later.bracket);
-            if (s == kRootPending) {
-                w.pending = true;
-                w.hit.iso_index = 0;
-                PendingHit& h = w.later;
-                h.t_in = t_in, h.t_out = t_out, h.p_in = p_in, h.p_out = p_out, h.cell_spacing = cell_spacing;
-                std::memcpy(h.corner, corner, sizeof h.corner);
-                return true;
-            }
-            if (!(s >= 0)) return false;
-            w.hit.iso_index = 0;
-            set_hit_at(w, s, corner, p_in, p_out, t_in, t_out, cell_spacing);
-            return true;
-        }
-    }
+    // With several isovalues the nearest root needs every root refined, so only one defers.
+    RootBracket* later = nullptr;
+    if constexpr (kDefer && std::is_same_v<Finder, Neubauer>)
+        if (scene.iso_count == 1) later = &w.later.bracket;
     double best_s = 2.0;
     int best = -1;
     for (int i = 0; i < scene.iso_count; ++i) {
         const double iso = scene.isovalues[i];
         if (!(lo <= iso && iso <= hi)) continue;
-        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end);
+        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end, later);
+        if (s == kRootPending) {   // only with `later`: the one isovalue's root, refined in finish_hit
+            w.pending = true;
+            w.hit.iso_index = i;
+            PendingHit& h = w.later;
+            h.t_in = t_in, h.t_out = t_out, h.p_in = p_in, h.p_out = p_out, h.cell_spacing = cell_spacing;
+            std::memcpy(h.corner, corner, sizeof h.corner);
+            return true;
+        }
         if (s >= 0 && s < best_s) best_s = s, best = i;
     }
     if (best < 0) return false;

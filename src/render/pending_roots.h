@@ -145,41 +145,39 @@ template <class Finder, class Lane> inline void finish_hits(const Finder& finder
             V4d v[8];
             for (int j = 0; j < 8; ++j) load4(v[j], by_part[j]);
             const V4d refined = neubauer_refine4(finder.iterations, v, v[4], v[5], v[6], v[7]);
-            // nearest_root's tail (set_hit_at) with the normals four at a time.
+            // nearest_root's tail (set_hit_at) with the normals four at a time where all four want
+            // one; world_normal itself for a lane off world_normal4's common path.
             double by_axis[17][4];   // the hits' points, their corners, spacings, world directions
             bool normals = true;
             for (int i = 0; i < 4; ++i) {
                 RayState& w = lane[k[i]];
                 const PendingHit& h = w.later;
                 const double s = roots_detail::into_bracket(refined[i], h.bracket.a, h.bracket.b);
-                w.hit.t = h.t_in + s * (h.t_out - h.t_in);
+                w.hit.t = piece_t(h.t_in, h.t_out, s);
                 normals &= w.want_normal;
+                const std::array<double, 3> p = segment_point(h.p_in, h.p_out, s);
                 for (int a = 0; a < 3; ++a) {
-                    by_axis[a][i] = h.p_in[a] + s * (h.p_out[a] - h.p_in[a]);
+                    by_axis[a][i] = p[a];
                     by_axis[11 + a][i] = h.cell_spacing[a];
                     by_axis[14 + a][i] = w.world_dir[a];
                 }
                 for (int j = 0; j < 8; ++j) by_axis[3 + j][i] = h.corner[j];
             }
+            V4d normal[3] = {};
+            V4l ok{0, 0, 0, 0};
             if (normals) {
-                V4d in[17], n[3];
+                V4d in[17];
                 for (int j = 0; j < 17; ++j) load4(in[j], by_axis[j]);
-                const V4l ok = world_normal4(in + 3, in, in + 11, in + 14, n);
-                for (int i = 0; i < 4; ++i) {
-                    RayState& w = lane[k[i]];
-                    if (ok[i]) w.hit.normal = {n[0][i], n[1][i], n[2][i]};
-                    else w.hit.normal = world_normal(w.later.corner, {by_axis[0][i], by_axis[1][i], by_axis[2][i]},
-                                                     w.later.cell_spacing, w.world_dir);
-                }
-            } else {
-                for (int i = 0; i < 4; ++i) {
-                    RayState& w = lane[k[i]];
-                    if (w.want_normal)
-                        w.hit.normal = world_normal(w.later.corner, {by_axis[0][i], by_axis[1][i], by_axis[2][i]},
-                                                    w.later.cell_spacing, w.world_dir);
-                }
+                ok = world_normal4(in + 3, in, in + 11, in + 14, normal);
             }
-            for (int i = 0; i < 4; ++i) lane[k[i]].pending = false;
+            for (int i = 0; i < 4; ++i) {
+                RayState& w = lane[k[i]];
+                w.pending = false;
+                if (!w.want_normal) continue;
+                w.hit.normal = ok[i] ? std::array<double, 3>{normal[0][i], normal[1][i], normal[2][i]}
+                                     : world_normal(w.later.corner, {by_axis[0][i], by_axis[1][i], by_axis[2][i]},
+                                                    w.later.cell_spacing, w.world_dir);
+            }
         }
     }
 #endif
