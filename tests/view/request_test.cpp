@@ -142,6 +142,7 @@ TEST(ViewRequest, BoundsAreEnforced) {
     EXPECT_EQ(refusal(with(base(), "step", "1"), 1), "step");
     EXPECT_EQ(refusal(with(base(), "step", "4"), 4), "step");
     EXPECT_EQ(refusal(with(base(), "step", "0"), 0), "step");
+    EXPECT_EQ(refusal(base(), 0), "step");   // no step asked for: the default 0 is not a step either
 }
 
 }  // namespace
