@@ -54,10 +54,9 @@ struct RecordingFinder {
     std::vector<CellCall>* calls = nullptr;
 };
 
-/// `later` is the deferred-refinement bracket of nearest_root, which only Neubauer fills: null here.
+/// The last parameter is nearest_root's deferred-refinement bracket, which only Neubauer fills.
 double first_root(const RecordingFinder& r, const double corner[8], double iso, const std::array<double, 3>& p_in,
-                  const std::array<double, 3>& p_out, bool closed_end, RootBracket* later = nullptr) {
-    (void)later;
+                  const std::array<double, 3>& p_out, bool closed_end, RootBracket* = nullptr) {
     CellCall c;
     std::copy(corner, corner + 8, c.corner);
     c.iso = iso, c.p_in = p_in, c.p_out = p_out, c.closed_end = closed_end;

@@ -121,8 +121,9 @@ inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RaySt
                          const std::array<double, 3>& p_in, const std::array<double, 3>& p_out, double t_in, double t_out,
                          bool closed_end, const std::array<double, 3>& cell_spacing) {
     // With several isovalues the nearest root needs every root refined, so only one defers.
+    constexpr bool kMayDefer = kDefer && std::is_same_v<Finder, Neubauer>;
     RootBracket* later = nullptr;
-    if constexpr (kDefer && std::is_same_v<Finder, Neubauer>)
+    if constexpr (kMayDefer)
         if (scene.iso_count == 1) later = &w.later.bracket;
     double best_s = 2.0;
     int best = -1;
@@ -130,7 +131,9 @@ inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RaySt
         const double iso = scene.isovalues[i];
         if (!(lo <= iso && iso <= hi)) continue;
         const double s = first_root(finder, corner, iso, p_in, p_out, closed_end, later);
-        if (s == kRootPending) {   // only with `later`: the one isovalue's root, refined in finish_hit
+        // Only with `later`: the one isovalue's root, refined by finish_hit(s) (pending_roots.h).
+        // The other instantiations never see kRootPending and compile the test away.
+        if (kMayDefer && s == kRootPending) {
             w.pending = true;
             w.hit.iso_index = i;
             PendingHit& h = w.later;

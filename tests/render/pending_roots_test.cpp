@@ -121,6 +121,8 @@ TEST(PendingRoots, FourAtATimeInAvx2EqualsTheScalarRefinementLaneByLane) {
     brackets.push_back({{-0.5, 1, 0, 0}, 0, -0.5, 1, 0.5});
     brackets.push_back({{-0.25, 1, 0, 0}, 0, -0.25, 0.75, 0.5});
     brackets.push_back({{-0.5, 1, 0, 0}, 0, -0.5, 0.25, 1e-300});
+    // A monotone cubic on [0.2, 0.9] whose steps keep each end twice: Illinois halvings on both sides.
+    brackets.push_back({{0.5, -1, 0.25, 0.125}, 0.2, 0.31, 0.9, -0.2});
     int exact_exits = 0;
     for (int iterations : {0, 1, 2, 5, 9}) {
         const Neubauer finder{iterations};
