@@ -121,7 +121,9 @@ TEST(PendingRoots, FourAtATimeInAvx2EqualsTheScalarRefinementLaneByLane) {
     brackets.push_back({{-0.5, 1, 0, 0}, 0, -0.5, 1, 0.5});
     brackets.push_back({{-0.25, 1, 0, 0}, 0, -0.25, 0.75, 0.5});
     brackets.push_back({{-0.5, 1, 0, 0}, 0, -0.5, 0.25, 1e-300});
-    // A monotone cubic on [0.2, 0.9] whose steps keep each end twice: Illinois halvings on both sides.
+    // A cubic decreasing on [0.2, 0.9], given fa = 0.31 and fb = -0.2 (f's own values there are
+    // 0.311 and -0.106; refine uses what it is given): its steps keep each end twice, so Illinois
+    // halves fb at step 2 and fa at steps 4, 7 and 8 (a scalar trace of Neubauer::refine).
     brackets.push_back({{0.5, -1, 0.25, 0.125}, 0.2, 0.31, 0.9, -0.2});
     int exact_exits = 0;
     for (int iterations : {0, 1, 2, 5, 9}) {
