@@ -26,35 +26,7 @@ import json
 
 import numpy as np
 
-
-def bit_length(a):
-    """Bits to hold each non-negative value of a (0 for 0)."""
-    out = np.zeros(a.shape, np.int64)
-    v = a.astype(np.int64)
-    while (v > 0).any():
-        out += v > 0
-        v >>= 1
-    return out
-
-
-def box_range(v, step, offsets):
-    """Min and max over the voxels at block origin (step apart) + each (dz, dy, dx) of offsets,
-    cut at the data's last voxel; None where offsets is empty."""
-    nz, ny, nx = v.shape
-    lo = hi = None
-    for dz, dy, dx in offsets:
-        iz = np.minimum(np.arange(0, nz, step) + dz, nz - 1)
-        iy = np.minimum(np.arange(0, ny, step) + dy, ny - 1)
-        ix = np.minimum(np.arange(0, nx, step) + dx, nx - 1)
-        s = v[np.ix_(iz, iy, ix)]
-        lo = s if lo is None else np.minimum(lo, s)
-        hi = s if hi is None else np.maximum(hi, s)
-    return lo, hi
-
-
-def cube(origin, width):
-    ox, oy, oz = origin
-    return [(oz + z, oy + y, ox + x) for z in range(width) for y in range(width) for x in range(width)]
+from cap_layout_count import bit_length, box_range, cube, read_volume   # same folder
 
 
 def main():
@@ -67,12 +39,7 @@ def main():
     ap.add_argument("--json", help="write the counts here")
     a = ap.parse_args()
     nx, ny, nz = a.dims
-    if min(a.dims) < 4 or any(n % 4 for n in a.dims):
-        raise SystemExit(f"{a.raw}: sides must be multiples of 4, got {nx}x{ny}x{nz}")
-    v = np.fromfile(a.raw, dtype=np.uint8)
-    if v.size != nx * ny * nz:
-        raise SystemExit(f"{a.raw}: {v.size} bytes, not {nx}x{ny}x{nz}")
-    v = v.reshape(nz, ny, nx).astype(np.int64)
+    v = read_volume(a.raw, a.dims)
 
     # Per cap parent (4^3 voxels) and child octant (cx, cy, cz): block, lattice and loose ranges.
     octants = [(cx, cy, cz) for cx in (0, 1) for cy in (0, 1) for cz in (0, 1)]

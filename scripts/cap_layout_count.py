@@ -29,20 +29,41 @@ def bit_length(a):
     return out
 
 
-def lattice_range(v, step, width):
-    """Min and max over the width^3 voxels from each block origin (step apart), cut at the data."""
+def box_range(v, step, offsets):
+    """Min and max over the voxels at each block origin (step apart) + each (dz, dy, dx) of
+    offsets, cut at the data's last voxel."""
     nz, ny, nx = v.shape
     lo = hi = None
-    for dz in range(width):
-        for dy in range(width):
-            for dx in range(width):
-                iz = np.minimum(np.arange(0, nz, step) + dz, nz - 1)
-                iy = np.minimum(np.arange(0, ny, step) + dy, ny - 1)
-                ix = np.minimum(np.arange(0, nx, step) + dx, nx - 1)
-                s = v[np.ix_(iz, iy, ix)]
-                lo = s if lo is None else np.minimum(lo, s)
-                hi = s if hi is None else np.maximum(hi, s)
+    for dz, dy, dx in offsets:
+        iz = np.minimum(np.arange(0, nz, step) + dz, nz - 1)
+        iy = np.minimum(np.arange(0, ny, step) + dy, ny - 1)
+        ix = np.minimum(np.arange(0, nx, step) + dx, nx - 1)
+        s = v[np.ix_(iz, iy, ix)]
+        lo = s if lo is None else np.minimum(lo, s)
+        hi = s if hi is None else np.maximum(hi, s)
     return lo, hi
+
+
+def cube(origin, width):
+    """The (dz, dy, dx) offsets of the width^3 voxels from origin (x, y, z)."""
+    ox, oy, oz = origin
+    return [(oz + z, oy + y, ox + x) for z in range(width) for y in range(width) for x in range(width)]
+
+
+def lattice_range(v, step, width):
+    """Min and max over the width^3 voxels from each block origin (step apart), cut at the data."""
+    return box_range(v, step, cube((0, 0, 0), width))
+
+
+def read_volume(raw, dims):
+    """The raw x-fastest u8 array as (z, y, x) int64, its sides checked to be multiples of 4."""
+    nx, ny, nz = dims
+    if min(dims) < 4 or any(n % 4 for n in dims):
+        raise SystemExit(f"{raw}: sides must be multiples of 4, got {nx}x{ny}x{nz}")
+    v = np.fromfile(raw, dtype=np.uint8)
+    if v.size != nx * ny * nz:
+        raise SystemExit(f"{raw}: {v.size} bytes, not {nx}x{ny}x{nz}")
+    return v.reshape(nz, ny, nx).astype(np.int64)
 
 
 def blocks(a, side):
@@ -58,12 +79,7 @@ def main():
     ap.add_argument("--json", help="write the counts here")
     a = ap.parse_args()
     nx, ny, nz = a.dims
-    if min(a.dims) < 4 or any(n % 4 for n in a.dims):
-        raise SystemExit(f"{a.raw}: sides must be multiples of 4, got {nx}x{ny}x{nz}")
-    v = np.fromfile(a.raw, dtype=np.uint8)
-    if v.size != nx * ny * nz:
-        raise SystemExit(f"{a.raw}: {v.size} bytes, not {nx}x{ny}x{nz}")
-    v = v.reshape(nz, ny, nx).astype(np.int64)
+    v = read_volume(a.raw, a.dims)
 
     own = blocks(v, 2)
     own_lo, own_hi = own.min(axis=(1, 3, 5)), own.max(axis=(1, 3, 5))
