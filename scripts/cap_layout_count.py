@@ -60,7 +60,10 @@ def read_volume(raw, dims):
     nx, ny, nz = dims
     if min(dims) < 4 or any(n % 4 for n in dims):
         raise SystemExit(f"{raw}: sides must be multiples of 4, got {nx}x{ny}x{nz}")
-    v = np.fromfile(raw, dtype=np.uint8)
+    try:
+        v = np.fromfile(raw, dtype=np.uint8)
+    except OSError as e:
+        raise SystemExit(f"{raw}: {e.strerror or e}")
     if v.size != nx * ny * nz:
         raise SystemExit(f"{raw}: {v.size} bytes, not {nx}x{ny}x{nz}")
     return v.reshape(nz, ny, nx).astype(np.int64)
