@@ -65,14 +65,19 @@ def main():
         return lo, hi
 
     stored = {c: block[c][0] != block[c][1] for c in octants}
-    has_caps = np.zeros(stored[octants[0]].shape, bool)
-    for c in octants:
-        has_caps |= stored[c]
-    cap_parents = int(np.prod(has_caps.shape))   # every cap parent: a 4^3 block that is not one value
-    uniform = np.ones(has_caps.shape, bool)
+    # A cap parent is every 4^3 block that is not one value (the builder merges those into leaves).
+    uniform = np.ones(block[octants[0]][0].shape, bool)
     for c in octants:
         uniform &= (block[c][0] == block[c][1]) & (block[c][0] == block[octants[0]][0])
     cap_parents = int((~uniform).sum())
+
+    def file_bytes(record_bytes, cap_bytes):
+        """The format-6 file with its cap-parent records and caps replaced by these."""
+        return a.file_bytes - cap_parents * 28 - a.cap_bytes + record_bytes + cap_bytes
+
+    def holds(lo, hi, iso):
+        """The tracer's cull: an integer range holds iso where lo <= floor(iso) and hi >= ceil(iso)."""
+        return (lo <= iso) & (iso <= hi)
     caps = int(sum(stored[c].sum() for c in octants))
     cap_bytes = int(sum(np.where(stored[c], bit_length(block[c][1] - block[c][0]), 0).sum() for c in octants))
     counts = {
@@ -89,7 +94,7 @@ def main():
     }
     for faces, face_bytes in (("shell", 2), ("faces", 6)):
         record = 16 + face_bytes + 2   # block min[8], max[8], the shell ranges, child_offset
-        total = a.file_bytes - cap_parents * 28 - a.cap_bytes + cap_parents * record + cap_bytes
+        total = file_bytes(cap_parents * record, cap_bytes)
         counts["layouts"][faces] = {"record_bytes": record, "file_bytes": total,
                                     "of_raw": round(total / v.size, 4)}
     # The same record with its 18 bounds (16 block bounds, the shell's two) stored relative to
@@ -98,7 +103,7 @@ def main():
     parent_lo, parent_hi = box_range(v, 4, cube((0, 0, 0), 5))
     rel_bits = bit_length(parent_hi - parent_lo)[~uniform]
     rel_record = int(((18 * rel_bits + 7) // 8 + 2).sum())
-    total = a.file_bytes - cap_parents * 28 - a.cap_bytes + rel_record + cap_bytes
+    total = file_bytes(rel_record, cap_bytes)
     counts["layouts"]["shell_relative"] = {"record_bytes_mean": round(rel_record / cap_parents, 2),
                                            "file_bytes": total, "of_raw": round(total / v.size, 4)}
     # A fixed 18-byte record: the 18 bounds as 7-bit codes relative to the parent's range in 16
@@ -114,22 +119,19 @@ def main():
         lo_r = np.where(halve, parent_lo + ((lo - parent_lo) // 2) * 2, lo)
         hi_r = np.where(halve, np.minimum(parent_lo + ((hi - parent_lo) // 2) * 2 + 1, 255), hi)
         fixed_caps += int(np.where(stored[c], bit_length(hi_r - lo_r), 0).sum())
-    total = a.file_bytes - cap_parents * 28 - a.cap_bytes + cap_parents * 18 + fixed_caps
+    total = file_bytes(cap_parents * 18, fixed_caps)
     counts["layouts"]["shell_relative_fixed18"] = {"record_bytes": 18, "cap_bytes": fixed_caps,
                                                    "parents_in_steps_of_2": int(halve.sum()),
                                                    "file_bytes": total, "of_raw": round(total / v.size, 4)}
     for iso in a.iso:
         row = {"iso": iso}
-        parent_live = np.zeros(has_caps.shape, bool)
-        for c in octants:
-            parent_live |= (lattice[c][0] < iso) & (iso < lattice[c][1])
         live = {"lattice": 0, "shell": 0, "faces": 0}
         for c in octants:
             lo, hi = lattice[c]
-            live["lattice"] += int(((lo < iso) & (iso < hi) & ~uniform).sum())
+            live["lattice"] += int((holds(lo, hi, iso) & ~uniform).sum())
             for faces in ("shell", "faces"):
                 lo, hi = loose(c, faces)
-                live[faces] += int(((lo < iso) & (iso < hi) & ~uniform).sum())
+                live[faces] += int((holds(lo, hi, iso) & ~uniform).sum())
         row["children_live"] = live
         row["extra_vs_lattice"] = {k: round(live[k] / live["lattice"], 3) for k in ("shell", "faces")}
         counts["cull"].append(row)
