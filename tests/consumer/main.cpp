@@ -2,7 +2,9 @@
 // headers, octiso::core, octisoConfig.cmake). It builds an octree from a small array (a sphere's
 // distance field), renders one frame of the isosurface at radius 5 and exits 0 only if the frame
 // hit the surface. Built twice: octiso_consumer links octiso::core only; octiso_consumer_io
-// (OCTISO_CONSUMER_IO) links octiso::io as well and writes the frame to the PNG named by argv[1].
+// (OCTISO_CONSUMER_IO) links octiso::io as well, writes the frame to the PNG named by argv[1]
+// (through the installed image module) and the field to argv[1] + ".vti", which it reads back
+// (through the installed volume module).
 // Run by the ConsumerProject ctest test (run_consumer_test.cmake).
 #include <cmath>
 #include <cstdio>
@@ -12,7 +14,12 @@
 #include "octiso/render.h"
 #include "octiso/version.h"
 #ifdef OCTISO_CONSUMER_IO
+#include <span>
+#include <string>
+
 #include "octiso/image.h"
+#include "octiso/reader.h"
+#include "octiso/volume_writer.h"
 #endif
 
 int main([[maybe_unused]] int argc, [[maybe_unused]] char** argv) {
@@ -39,6 +46,11 @@ int main([[maybe_unused]] int argc, [[maybe_unused]] char** argv) {
 #ifdef OCTISO_CONSUMER_IO
     if (argc != 2) return 1;
     octiso::write_colour_image(argv[1], frame);
+    const std::string vti = std::string(argv[1]) + ".vti";
+    octiso::write_volume_file(vti, octiso::ScalarType::f32, volume.dims, placement,
+                              std::as_bytes(std::span<const float>(field)));
+    const octiso::LoadedVolume back = octiso::open_volume(vti, octiso::RawOptions{});
+    if (back.dims().x != n || back.dims().y != n || back.dims().z != n) return 1;
 #endif
     return frame.stats.hits > 0 && frame.stats.hits < frame.stats.rays ? 0 : 1;
 }

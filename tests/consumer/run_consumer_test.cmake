@@ -49,9 +49,11 @@ execute_process(COMMAND ${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${WORK_DIR
 execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/build COMMAND_ERROR_IS_FATAL ANY)
 
 # 4. Each builds an octree, renders a frame and exits 0 only if the frame hit the surface; the io
-#    one also writes the frame as a PNG.
+#    one also writes the frame as a PNG and its field as .vti, read back (both modules installed).
 execute_process(COMMAND ${WORK_DIR}/build/octiso_consumer COMMAND_ERROR_IS_FATAL ANY)
 execute_process(COMMAND ${WORK_DIR}/build/octiso_consumer_io ${WORK_DIR}/frame.png COMMAND_ERROR_IS_FATAL ANY)
-if(NOT EXISTS ${WORK_DIR}/frame.png)
-  message(FATAL_ERROR "octiso_consumer_io wrote no ${WORK_DIR}/frame.png")
-endif()
+foreach(f frame.png frame.png.vti)
+  if(NOT EXISTS ${WORK_DIR}/${f})
+    message(FATAL_ERROR "octiso_consumer_io wrote no ${WORK_DIR}/${f}")
+  endif()
+endforeach()
