@@ -136,34 +136,19 @@ std::optional<octiso::ScalarType> scalar_type_from_vtk(int vtk_type) {
     }
 }
 
-vtkSmartPointer<vtkAlgorithm> make_reader(octiso::VolumeFormat format, const std::string& path) {
-    using octiso::VolumeFormat;
+template <class Reader> vtkSmartPointer<vtkAlgorithm> reader_of(const std::string& path) {
+    auto r = vtkSmartPointer<Reader>::New();
+    r->SetFileName(path.c_str());
+    return r;
+}
+
+vtkSmartPointer<vtkAlgorithm> make_reader(VolumeFormat format, const std::string& path) {
     switch (format) {
-        case VolumeFormat::nifti: {
-            auto r = vtkSmartPointer<vtkNIFTIImageReader>::New();
-            r->SetFileName(path.c_str());
-            return r;
-        }
-        case VolumeFormat::vti: {
-            auto r = vtkSmartPointer<vtkXMLImageDataReader>::New();
-            r->SetFileName(path.c_str());
-            return r;
-        }
-        case VolumeFormat::legacy_vtk: {
-            auto r = vtkSmartPointer<vtkStructuredPointsReader>::New();
-            r->SetFileName(path.c_str());
-            return r;
-        }
-        case VolumeFormat::meta_image: {
-            auto r = vtkSmartPointer<vtkMetaImageReader>::New();
-            r->SetFileName(path.c_str());
-            return r;
-        }
-        case VolumeFormat::nrrd: {
-            auto r = vtkSmartPointer<vtkNrrdReader>::New();
-            r->SetFileName(path.c_str());
-            return r;
-        }
+        case VolumeFormat::nifti: return reader_of<vtkNIFTIImageReader>(path);
+        case VolumeFormat::vti: return reader_of<vtkXMLImageDataReader>(path);
+        case VolumeFormat::legacy_vtk: return reader_of<vtkStructuredPointsReader>(path);
+        case VolumeFormat::meta_image: return reader_of<vtkMetaImageReader>(path);
+        case VolumeFormat::nrrd: return reader_of<vtkNrrdReader>(path);
         default: break;
     }
     throw octiso::Error(path, "not a VTK-readable format", octiso::ErrorKind::Other);
