@@ -627,6 +627,8 @@ private:
     /// whole-view real scans and 256^3 fields within the noise, 0.98-1.04 x at the minimum
     /// (build_ab_packet_cap_cells*.json); from 2 lanes the whole views gained 1-4 % but plume 64^3
     /// lost 6 % (the split and the enter of all 8 cells for 2-3 lanes cost more than the walks).
+    /// From 3, 4 or 7 lanes on the real scans since: 1.005-1.073 x and 0.996-1.016 x at the minimum
+    /// (build_ab_cap_packet_from_{3,4}_lanes_stop51.json, build_ab_cap_packet_from_7_lanes_stop52.json).
     static constexpr int kMinCapPacketLanes = 5;
 
     /// The lanes of `active` that hit in the cap `ref` at `co` (its lattice `blocks`), each on its
