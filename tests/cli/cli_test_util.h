@@ -33,6 +33,12 @@ inline ToolRun run_tool(const std::string& tool, const std::string& args, const 
     return r;
 }
 
+/// What `ldd` lists for `program` (its shared libraries, transitively); empty if ldd fails.
+inline std::string shared_libraries_of(const std::string& program) {
+    std::string deps;
+    return run_shell("ldd '" + program + "'", &deps) == 0 ? deps : std::string();
+}
+
 template <typename T> void write_raw(const std::string& path, const std::vector<T>& values) {
     std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(values.data()), std::streamsize(values.size() * sizeof(T)));
 }
