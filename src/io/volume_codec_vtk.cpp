@@ -120,8 +120,7 @@ std::string clean_vtk_message(std::string text) {
     return text.empty() ? "VTK reported an error" : text;
 }
 
-std::optional<octiso::ScalarType> scalar_type_from_vtk(int vtk_type) {
-    using octiso::ScalarType;
+std::optional<ScalarType> scalar_type_from_vtk(int vtk_type) {
     switch (vtk_type) {
         case VTK_UNSIGNED_CHAR: return ScalarType::u8;
         case VTK_CHAR:
@@ -151,14 +150,13 @@ vtkSmartPointer<vtkAlgorithm> make_reader(VolumeFormat format, const std::string
         case VolumeFormat::nrrd: return reader_of<vtkNrrdReader>(path);
         default: break;
     }
-    throw octiso::Error(path, "not a VTK-readable format", octiso::ErrorKind::Other);
+    throw Error(path, "not a VTK-readable format", ErrorKind::Other);
 }
 
 // Runs the reader (the whole read, or the header only) with both of VTK's error channels captured;
 // the first message becomes Error(path, what + message).
-void run_captured(vtkAlgorithm* reader, octiso::VolumeFormat format, const std::string& path, const std::string& what,
+void run_captured(vtkAlgorithm* reader, VolumeFormat format, const std::string& path, const std::string& what,
                   bool information_only) {
-    using octiso::Error;
     ErrorCatcher catcher;
     auto callback = vtkSmartPointer<vtkCallbackCommand>::New();
     callback->SetCallback(&ErrorCatcher::on_error);
@@ -167,7 +165,7 @@ void run_captured(vtkAlgorithm* reader, octiso::VolumeFormat format, const std::
     t_vtk_window_text.clear();
     {
         std::optional<StdStreamsMuted> muted;
-        if (format == octiso::VolumeFormat::meta_image) muted.emplace();
+        if (format == VolumeFormat::meta_image) muted.emplace();
         try {
             if (information_only) reader->UpdateInformation();
             else reader->Update();
@@ -185,8 +183,8 @@ void run_captured(vtkAlgorithm* reader, octiso::VolumeFormat format, const std::
 }
 
 /// Voxel (0,0,0) of our grid is the extent's lower corner, not VTK's index 0.
-octiso::Placement placement_of(const double* spacing, const double* origin, const int* extent) {
-    octiso::Placement placement;
+Placement placement_of(const double* spacing, const double* origin, const int* extent) {
+    Placement placement;
     for (int a = 0; a < 3; ++a) {
         placement.spacing[size_t(a)] = spacing[a];
         placement.origin[size_t(a)] = origin[a] + extent[2 * a] * spacing[a];
@@ -296,8 +294,7 @@ io::VtkImageInformation read_information_of(const std::string& path, VolumeForma
 }
 
 
-int vtk_type_of(octiso::ScalarType t) {
-    using octiso::ScalarType;
+int vtk_type_of(ScalarType t) {
     switch (t) {
         case ScalarType::u8: return VTK_UNSIGNED_CHAR;
         case ScalarType::i8: return VTK_SIGNED_CHAR;
