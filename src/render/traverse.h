@@ -97,7 +97,12 @@ public:
         Walk w;
         const BoxClip clip = w.start(scene_, ray_world, want_normal);
         if constexpr (Recorder::kOn) recorder_.clip(clip.t_in, clip.t_out);
-        if (!clip.empty()) node(w, 0, 0, Coord{}, clip.t_in, clip.t_out);
+        if (!clip.empty()) {
+            int d = 0;
+            uint32_t index = 0;
+            Coord o{};
+            if (start_below_root(w, d, index, o, clip.t_in, clip.t_out)) node(w, d, index, o, clip.t_in, clip.t_out);
+        }
         if (w.pending) finish_hit(finder_, w);
         return w.hit;
     }
@@ -250,6 +255,44 @@ private:
         if (d > 0) return t_plane <= t;
         if (d < 0) return t < t_plane;
         return r.origin[a] > plane || (r.origin[a] == plane && plane < scene_.box_hi[a]);
+    }
+
+    /// A single ray starts in the deepest interior node whose one child piece holds its whole
+    /// piece [t0, t1) of the data box: node() there sees the same piece as when reached from the
+    /// root, since each node above would hand it on whole (no mid-plane time inside (t0, t1), the
+    /// start side by upper_at at t0: for_each_child_piece's own decisions), and a child that
+    /// node() would cull ends the ray as a miss here too (returns false). Only short pieces gain:
+    /// ambient-occlusion rays of a few voxels from a surface skip the upper levels' node visits,
+    /// which are cheap beside their cell walks near the surface: the `--ao 8` pass took 0.976-1.004 x
+    /// its time at the minimum, 0.944-0.991 x at the median on 4 of 5 files (scripts/build_ab.py,
+    /// 11 pairs, build_ab_ao_start_below_root.json); primary rays (pieces across the root's
+    /// mid-planes) never descend here. Issue 11's "rays start at the deepest node containing their
+    /// entry point", for the rays where it can apply without a bottom-up walk.
+    /// The recorder, sort-last boxes and level-of-detail cuts keep the descent from the root.
+    /// Fills w.trace for the levels passed (neighbour finding climbs it).
+    bool start_below_root(Walk& w, int& d, uint32_t& index, Coord& o, double t0, double t1) const {
+        if constexpr (Recorder::kOn || kOwned) return true;
+        if (restricted_ || lod_.on() || !(t0 < t1)) return true;
+        const IndexRay& r = w.ray;
+        while (d < tree_.dmax() - 2) {
+            const uint32_t half = tree_.child_bit(d);
+            const uint32_t origin[3] = {o.x, o.y, o.z};
+            int c = 0;
+            for (int a = 0; a < 3; ++a) {
+                const double mid = double(origin[a] + half);
+                const double tm = r.plane_t(a, mid);
+                if (tm > t0 && tm < t1) return true;   // crossed inside: node(d) splits the piece
+                if (upper_at(r, a, mid, tm, t0)) c |= 4 >> a;
+            }
+            const InteriorNode<T>& n = tree_.node(d, index);
+            if (n.is_scalar_leaf(c)) return true;
+            if (!LiveChildren<T>::holds(n, live_.of(n), c, scene_.isovalues, scene_.iso_count)) return false;
+            w.trace[d] = index;
+            index = tree_.child_index_at(tree_.first_child(d, index, n), n, c);
+            o = child_origin_of(o, c, half);
+            ++d;
+        }
+        return true;
     }
 
     // Node origins travel by reference: a Coord passed by value is assembled with 32-bit stores

@@ -284,6 +284,63 @@ TEST(PacketTraversal, BeamOfOneOriginEqualsSingleRaysThroughNodeCornersAndFaces)
     }
 }
 
+/// Single rays start in the deepest node whose one child holds their whole piece
+/// (OctreeTracer::start_below_root); trace_packet starts every lane at the root, as a packet or
+/// alone. Short pieces like ambient-occlusion rays (origins inside the data, [t_min, t_max] a few
+/// voxels long), many of them on node mid-planes of every level with +-0 direction components so
+/// that the start side is decided by the tie rules, must hit exactly what the descent from the
+/// root hits, in both kernels, also where the child a ray would start in is culled (the blocky
+/// and sparse data lack the isovalues in many nodes).
+TEST(PacketTraversal, ShortRaysStartingBelowTheRootEqualTheDescentFromTheRoot) {
+    const Dims dims{70, 66, 73};   // a cube of 128: seven levels above the caps
+    std::vector<Isa> isas{Isa::baseline};
+    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    for (Pattern pattern : {Pattern::Blocky, Pattern::Random, Pattern::Sparse}) {
+        const DenseVolume<uint8_t> v = make_volume<uint8_t>(dims, pattern, 13);
+        const OctreeData<uint8_t> data = build_octree(v.view(), {});
+        RenderOptions o;
+        o.isovalues = pattern == Pattern::Random ? std::vector<double>{127.5, 200.5} : std::vector<double>{1.5, 3.5};
+        for (Isa isa : isas) {
+            const TracerKernel kernel = make_tracer_kernel(data.view(), Placement{}, o, isa);
+            std::mt19937 rng(23);
+            std::uniform_real_distribution<double> u(0, 1);
+            uint64_t hits = 0, rays_traced = 0;
+            for (int i = 0; i < 6000; i += kMaxTracePacket) {
+                Ray rays[kMaxTracePacket];
+                for (int k = 0; k < kMaxTracePacket; ++k) {
+                    const int n = i + k;
+                    Ray& r = rays[k];
+                    for (int a = 0; a < 3; ++a) {
+                        const uint32_t extent = a == 0 ? dims.x : a == 1 ? dims.y : dims.z;
+                        r.origin[size_t(a)] = u(rng) * (extent - 1);
+                        // on a mid-plane of a node of side 2 .. 128 (a multiple of 1 .. 64)
+                        if ((n + a) % 3 == 0) r.origin[size_t(a)] = double((1 << (n % 7)) * int(u(rng) * (extent - 1) / (1 << (n % 7))));
+                    }
+                    std::array<double, 3> d{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5};
+                    if (n % 4 == 0) d[size_t(n % 3)] = (n % 8) ? 0.0 : -0.0;
+                    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    for (double& c : d) c /= len;
+                    r.dir = d;
+                    r.t_min = n % 5 == 0 ? 0.0 : 0.02 + 2 * u(rng);
+                    const double reach[] = {0.3, 1.5, 4, 10, 40};
+                    r.t_max = r.t_min + reach[n % 5];
+                }
+                TraceHit out[kMaxTracePacket];
+                kernel.trace_packet(kernel.user, rays, kMaxTracePacket, nullptr, true, out);
+                for (int k = 0; k < kMaxTracePacket; ++k) {
+                    const TraceHit alone = kernel.trace(kernel.user, rays[k], true);
+                    hits += alone.is_hit();
+                    ++rays_traced;
+                    ASSERT_TRUE(same_hit(alone, out[k])) << "isa " << int(isa) << ", pattern " << int(pattern) << ", ray "
+                                                         << i + k;
+                }
+            }
+            EXPECT_GT(hits, rays_traced / 20) << "the short rays must reach surfaces";
+            EXPECT_LT(hits, rays_traced) << "and miss some";
+        }
+    }
+}
+
 /// The lanes' starts (the AVX2 kernel computes them four lanes at a time, packet_start.h) on the
 /// rays that take the scalar start's every branch: +-0, subnormal, infinite and NaN direction
 /// components, NaN and infinite origins, rays parallel to a face outside, inside and in the face,
