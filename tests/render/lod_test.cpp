@@ -213,8 +213,7 @@ TEST(Lod, CloseUpAndLodZeroAreTheExactFrame) {
 /// normal bit for bit, in both kernels, on a smooth field and on one of scalar leaves, and stop at
 /// every unit from 1 to 16.
 TEST(Lod, PacketsStopWhereSingleRaysStop) {
-    std::vector<Isa> isas{Isa::baseline};
-    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    const std::vector<Isa> isas = kernel_isas();
     struct Case {
         Field field;
         double iso;

@@ -14,6 +14,7 @@
 #include "octiso/render.h"
 #include "octree/octree_test_util.h"
 #include "render/pinhole_camera.h"
+#include "render/render_test_util.h"
 #include "render/tracer_kernel.h"
 #include "render/traverse.h"
 #include "test_util/skip.h"
@@ -149,8 +150,7 @@ TEST(PacketTraversal, CloseUpFramesWhosePacketsShareCapsAreIdentical) {
             if (iso_count == 2) single.isovalues.push_back(0.2 * lo + 0.8 * hi + 0.25);
             const Frame reference = render(data.view(), Placement{}, camera, single);
             ASSERT_GT(reference.stats.hits, 2000u) << "the close view must be mostly surface";
-            std::vector<Isa> isas{Isa::baseline};
-            if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+            const std::vector<Isa> isas = kernel_isas();
             for (Isa isa : isas) {
                 RenderOptions o = single;
                 o.traversal = Traversal::packets, o.isa = isa;
@@ -178,8 +178,7 @@ uint64_t scalar_leaves_of_side(const Octree<uint8_t>& tree, uint32_t side) {
 /// isovalues between the labels and equal to them (then every cell of a leaf is walked): every
 /// frame of packets on both kernels must equal the single-ray frame bit for bit.
 void expect_label_views_of_packets_equal_single_rays(const Octree<uint8_t>& tree, int width, int height) {
-    std::vector<Isa> isas{Isa::baseline};
-    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    const std::vector<Isa> isas = kernel_isas();
     RenderOptions single;
     single.want_depth = single.want_normal = true;
     single.traversal = Traversal::single;
@@ -236,8 +235,7 @@ TEST(PacketTraversal, LeavesOfSideEightToThirtyTwoEqualTheSingleRayLeafWalk) {
 /// inside it or are switched off.
 TEST(PacketTraversal, BeamOfOneOriginEqualsSingleRaysThroughNodeCornersAndFaces) {
     const Dims dims{70, 66, 73};   // a cube of 128: the beam spans depths 0 to 3
-    std::vector<Isa> isas{Isa::baseline};
-    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    const std::vector<Isa> isas = kernel_isas();
     const std::array<double, 3> origins[] = {{64, 32, -16}, {-8, 64, 32}, {96, -12.5, 96}, {32, 16, 80}, {35.25, 33, 36}};
     for (Pattern pattern : {Pattern::Blocky, Pattern::Random}) {
         const DenseVolume<uint8_t> v = make_volume<uint8_t>(dims, pattern, 9);
@@ -293,8 +291,7 @@ TEST(PacketTraversal, BeamOfOneOriginEqualsSingleRaysThroughNodeCornersAndFaces)
 /// and sparse data lack the isovalues in many nodes).
 TEST(PacketTraversal, ShortRaysStartingBelowTheRootEqualTheDescentFromTheRoot) {
     const Dims dims{70, 66, 73};   // a cube of 128: seven levels above the caps
-    std::vector<Isa> isas{Isa::baseline};
-    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    const std::vector<Isa> isas = kernel_isas();
     for (Pattern pattern : {Pattern::Blocky, Pattern::Random, Pattern::Sparse}) {
         const DenseVolume<uint8_t> v = make_volume<uint8_t>(dims, pattern, 13);
         const OctreeData<uint8_t> data = build_octree(v.view(), {});
@@ -400,8 +397,7 @@ TEST(PacketTraversal, LaneStartsOfHostileRaysEqualSingleRays) {
         }
         rays.push_back(r);
     }
-    std::vector<Isa> isas{Isa::baseline};
-    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    const std::vector<Isa> isas = kernel_isas();
     for (Isa isa : isas) {
         const TracerKernel kernel = make_tracer_kernel(data.view(), placement, o, isa);
         uint64_t hits = 0;

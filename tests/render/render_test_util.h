@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -64,6 +65,13 @@ inline Camera look_at(std::array<double, 3> eye, std::array<double, 3> look, std
     Camera c;
     c.eye = eye, c.look = look, c.up = up, c.fov_deg = fov, c.width = c.height = size;
     return c;
+}
+
+/// The traversal kernels this CPU runs: the portable one, and AVX2 where the CPU has it.
+inline std::vector<Isa> kernel_isas() {
+    std::vector<Isa> isas{Isa::baseline};
+    if (cpu_has_avx2()) isas.push_back(Isa::avx2);
+    return isas;
 }
 
 /// `frame` (depth needed) against the exact reference of the dense volume at `iso`.
