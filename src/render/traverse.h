@@ -269,7 +269,11 @@ private:
     /// mid-planes) never descend here. Issue 11's "rays start at the deepest node containing their
     /// entry point", for the rays where it can apply without a bottom-up walk.
     /// The recorder, sort-last boxes and level-of-detail cuts keep the descent from the root.
-    /// Fills w.trace for the levels passed (neighbour finding climbs it).
+    /// Fills w.trace for the levels passed (neighbour finding climbs it). The loop's per-axis
+    /// decisions repeat for_each_child_piece's on purpose: the two sharing one inlined helper made
+    /// the packet frames 1.05-1.07 x slower (GCC's code for the hot walk changed; 7 and 9 pairs,
+    /// build_ab_review_start_child_packets*.json), so PacketTraversal.ShortRaysStartingBelowThe-
+    /// RootEqualTheDescentFromTheRoot keeps them equal instead.
     bool start_below_root(Walk& w, int& d, uint32_t& index, Coord& o, double t0, double t1) const {
         if constexpr (Recorder::kOn || kOwned) return true;
         if (restricted_ || lod_.on() || !(t0 < t1)) return true;
