@@ -255,9 +255,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         return series ? cli::format_step(*pattern, index, flag) : *pattern;
     };
     const long long first_index = jobs.front().index;
-    if (out_path) check_image_path(name_for(out_path, "-o", first_index), "-o");
-    if (depth_path) check_image_path(name_for(depth_path, "--depth", first_index), "--depth");
-    if (normal_path) check_image_path(name_for(normal_path, "--normal", first_index), "--normal");
+    if (out_path) check_image_path(name_for(out_path, "-o", first_index), "-o", ImageContent::Colour);
+    if (depth_path) check_image_path(name_for(depth_path, "--depth", first_index), "--depth", ImageContent::Aov);
+    if (normal_path) check_image_path(name_for(normal_path, "--normal", first_index), "--normal", ImageContent::Aov);
     if (depth_path && !image_format_holds_floats(name_for(depth_path, "--depth", first_index)))
         throw Error("--depth", "'" + name_for(depth_path, "--depth", first_index) +
                                    "' stores 8 bits; depth is a distance and needs a float format (.exr, .tif, .pfm, .hdr)");

@@ -1,9 +1,12 @@
 // include/octiso/image.h over the image codec (image_codec.h): OpenImageIO in a module loaded on
-// the first image, so that processes that never touch one do not load it.
+// the first image, so that processes that never touch one do not load it. The 8-bit colour PNG,
+// the image nearly every render writes, goes through libpng directly (png_writer.h): a render
+// that writes only PNG colour never loads the module.
 #include <algorithm>
 #include <cmath>
 
 #include "io/image_codec_loader.h"
+#include "io/png_writer.h"
 #include "util/atomic_output.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
@@ -39,6 +42,7 @@ void write_image(const std::string& path, int width, int height, int channels, P
 
 /// The float type a file format can hold: float where supported, else its native 8 bits.
 Pixel float_or_native(const std::string& path) {
+    if (io::is_png_path(path)) return Pixel::u8;
     const std::string fmt = image_codec::codec().output_format(path);
     if (fmt.empty()) throw Error(path, "no image format for this extension");
     if (fmt == "openexr" || fmt == "tiff" || fmt == "hdr" || fmt == "fits" || fmt == "pfm") return Pixel::f32;
@@ -47,7 +51,8 @@ Pixel float_or_native(const std::string& path) {
 
 }  // namespace
 
-void check_image_path(const std::string& path, const std::string& flag) {
+void check_image_path(const std::string& path, const std::string& flag, ImageContent content) {
+    if (content == ImageContent::Colour && io::is_png_path(path)) return;   // libpng, no module
     if (image_codec::codec().output_format(path).empty()) throw Error(flag, "'" + path + "': no image format for this extension");
 }
 
@@ -55,6 +60,13 @@ bool image_format_holds_floats(const std::string& path) { return float_or_native
 
 void write_colour_image(const std::string& path, const Frame& frame) {
     if (frame.rgb.empty()) throw Error(path, "the frame has no colour image", ErrorKind::Other);
+    if (frame.rgb.size() != size_t(frame.width) * size_t(frame.height) * 3)
+        throw Error(path, "the colour image is not width x height x 3 bytes", ErrorKind::Other);
+    if (io::is_png_path(path)) {
+        const std::vector<unsigned char> bytes = io::encode_rgb8_png(frame.width, frame.height, frame.rgb.data(), io::kPngFile, path);
+        write_file_atomically(path, bytes.data(), bytes.size());
+        return;
+    }
     write_image(path, frame.width, frame.height, 3, Pixel::u8, frame.rgb.data(), {"R", "G", "B"}, Pixel::u8);
 }
 

@@ -1,6 +1,6 @@
-// encode_png: a frame's 8-bit sRGB colour as PNG bytes in memory (OpenImageIO through an I/O
-// proxy, the encoder octiso-render's files come from), the viewer's frame format: lossless, so
-// the page shows exactly the pixels octiso-render writes (the end-to-end test compares them).
+// encode_png: a frame's 8-bit sRGB colour as PNG bytes in memory (libpng, the encoder
+// octiso-render's PNG files come from), the viewer's frame format: lossless, so the page shows
+// exactly the pixels octiso-render writes (the end-to-end test compares them).
 #pragma once
 
 #include <string>
@@ -9,8 +9,8 @@
 
 namespace octiso::view {
 
-/// PNG of frame.rgb (width x height x 3). zlib level 1: at 1024^2 the default level costs more
-/// than the render, and the bytes only cross loopback. Throws Error(ErrorKind::Other) if the
+/// PNG of frame.rgb (width x height x 3) at io::kPngStream (zlib 1, unfiltered rows): at 1024^2
+/// the file settings cost more than the render, and the bytes only cross a socket. Throws Error(ErrorKind::Other) if the
 /// encoder fails.
 std::string encode_png(const Frame& frame);
 

@@ -1,6 +1,8 @@
 // OpenImageIO lives in liboctiso_images.so, loaded on the first image (src/io/image_codec.h):
 // nothing octiso builds may depend on it at start-up, the tools still write images through it, and
-// a tool that cannot load it says so in one line, writes nothing and exits 1 (not bad input).
+// a tool that cannot load it says so in one line, writes nothing and exits 1 (not bad input). The
+// 8-bit colour PNG is written by libpng without the module (src/io/png_writer.h): a render that
+// writes only that never loads it.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -8,6 +10,7 @@
 #include <vector>
 
 #include "cli/cli_test_util.h"
+#include "octiso/image.h"
 
 namespace octiso::test {
 namespace {
@@ -57,15 +60,38 @@ TEST_F(ImageModuleCli, RenderWritesImagesThroughTheModuleItFindsItself) {
     EXPECT_EQ(forced.status, 0) << forced.err;
 }
 
-TEST_F(ImageModuleCli, AMissingModuleIsOneLineExitOneAndNoOutput) {
-    const std::string png = dir_.file("frame.png");
+TEST_F(ImageModuleCli, AColourPngNeedsNoModule) {
+    const std::string png = dir_.file("frame.png"), through_module = dir_.file("frame.tif");
     const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "'",
+                               "OCTISO_IMAGE_MODULE=/nonexistent/liboctiso_images.so");
+    ASSERT_EQ(r.status, 0) << r.err;
+    // The same pixels as OpenImageIO's own 8-bit writer gives the same frame.
+    ASSERT_EQ(run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + through_module + "'").status, 0);
+    const FloatImage a = read_image(png), b = read_image(through_module);
+    EXPECT_EQ(a.width, 40);
+    EXPECT_EQ(a.channels, 3);
+    EXPECT_EQ(a.pixels, b.pixels);
+}
+
+TEST_F(ImageModuleCli, AMissingModuleIsOneLineExitOneAndNoOutput) {
+    // A PNG colour image with a depth image beside it: the depth image needs the module.
+    const std::string png = dir_.file("frame.png"), exr = dir_.file("depth.exr");
+    const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "' --depth '" + exr + "'",
                                "OCTISO_IMAGE_MODULE=/nonexistent/liboctiso_images.so");
     EXPECT_EQ(r.status, 1) << r.err;   // the installation, not the input (ErrorKind::Other)
     EXPECT_EQ(r.err_lines(), 1) << r.err;
     EXPECT_NE(r.err.find("image module liboctiso_images.so"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("/nonexistent/liboctiso_images.so"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(png));
+    EXPECT_FALSE(std::filesystem::exists(exr));
+    EXPECT_EQ(dir_.entries(), std::vector<std::string>{"plume.oct"}) << "nothing but the input may be left";
+    // An 8-bit normal image in PNG goes through the module too (OpenImageIO maps the floats), so
+    // it is refused before the colour PNG, which would not need it, is written.
+    const std::string normal = dir_.file("normal.png");
+    const ToolRun n = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "' --normal '" + normal + "'",
+                               "OCTISO_IMAGE_MODULE=/nonexistent/liboctiso_images.so");
+    EXPECT_EQ(n.status, 1) << n.err;
+    EXPECT_EQ(n.err_lines(), 1) << n.err;
     EXPECT_EQ(dir_.entries(), std::vector<std::string>{"plume.oct"}) << "nothing but the input may be left";
 }
 
