@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libtbb-dev libembree-dev libopenimageio-dev openimageio-tools libvtk9-dev
-  libgtest-dev libbenchmark-dev libxxhash-dev zstd libzstd-dev libpng-dev zlib1g-dev
+  libgtest-dev libbenchmark-dev libxxhash-dev zstd libzstd-dev libpng-dev libopenexr-dev zlib1g-dev
   libopenvdb-dev libboost-iostreams-dev mricron-data invesalius-examples
   python3-numpy python3-matplotlib python3-dev pybind11-dev python3-pytest python3-nibabel clang
   nlohmann-json3-dev libfmt-dev libcli11-dev python3-pil

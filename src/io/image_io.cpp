@@ -1,13 +1,16 @@
 // include/octiso/image.h over the image codec (image_codec.h): OpenImageIO in a module loaded on
 // the first image, so that processes that never touch one do not load it. The 8-bit colour PNG,
-// the image nearly every render writes, goes through libpng directly (png_writer.h): a render
-// that writes only PNG colour never loads the module.
+// the image nearly every render writes, goes through libpng directly (png_writer.h), and float
+// images in OpenEXR (the depth and normal AOVs) through OpenEXR directly (exr_writer.h): a render
+// that writes only those never loads the module.
 #include <algorithm>
 #include <cmath>
 
+#include "io/exr_writer.h"
 #include "io/image_codec_loader.h"
 #include "io/png_writer.h"
 #include "util/atomic_output.h"
+#include "util/check.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
 
@@ -19,13 +22,19 @@ using image_codec::Pixel;
 
 void write_image(const std::string& path, int width, int height, int channels, Pixel type, const void* pixels,
                  const std::vector<std::string>& names, Pixel file_type) {
-    const image_codec::ImageCodec& codec = image_codec::codec();
+    // Encode into memory, then write the bytes ourselves with every write checked: OIIO's PNG
+    // writer did not report ENOSPC, and a truncated PNG was renamed into place (issue 18).
+    if (type == Pixel::f32 && file_type == Pixel::f32 && io::is_exr_path(path)) {   // OpenEXR, no module
+        OCTISO_CHECK(names.size() == size_t(channels), "one name per channel");
+        const std::vector<unsigned char> bytes = io::encode_float_exr(width, height, static_cast<const float*>(pixels), names, path);
+        write_file_atomically(path, bytes.data(), bytes.size());
+        return;
+    }
     const image_codec::EncodeRequest request{&path, width, height, channels, type, pixels, &names, file_type, -1};
     auto check = [&](const image_codec::Failure& f) {
         if (f.failed()) throw Error(path, f.message, f.other ? ErrorKind::Other : ErrorKind::BadInput);
     };
-    // Encode into memory, then write the bytes ourselves with every write checked: OIIO's PNG
-    // writer did not report ENOSPC, and a truncated PNG was renamed into place (issue 18).
+    const image_codec::ImageCodec& codec = image_codec::codec();
     std::vector<unsigned char> bytes;
     bool in_memory = false;
     check(codec.encode(request, bytes, in_memory));
@@ -43,6 +52,7 @@ void write_image(const std::string& path, int width, int height, int channels, P
 /// The float type a file format can hold: float where supported, else its native 8 bits.
 Pixel float_or_native(const std::string& path) {
     if (io::is_png_path(path)) return Pixel::u8;
+    if (io::is_exr_path(path)) return Pixel::f32;
     const std::string fmt = image_codec::codec().output_format(path);
     if (fmt.empty()) throw Error(path, "no image format for this extension");
     if (fmt == "openexr" || fmt == "tiff" || fmt == "hdr" || fmt == "fits" || fmt == "pfm") return Pixel::f32;
@@ -53,6 +63,7 @@ Pixel float_or_native(const std::string& path) {
 
 void check_image_path(const std::string& path, const std::string& flag, ImageContent content) {
     if (content == ImageContent::Colour && io::is_png_path(path)) return;   // libpng, no module
+    if (content == ImageContent::Aov && io::is_exr_path(path)) return;      // OpenEXR, no module
     if (image_codec::codec().output_format(path).empty()) throw Error(flag, "'" + path + "': no image format for this extension");
 }
 

@@ -1,8 +1,8 @@
 // OpenImageIO lives in liboctiso_images.so, loaded on the first image (src/io/image_codec.h):
 // nothing octiso builds may depend on it at start-up, the tools still write images through it, and
 // a tool that cannot load it says so in one line, writes nothing and exits 1 (not bad input). The
-// 8-bit colour PNG is written by libpng without the module (src/io/png_writer.h): a render that
-// writes only that never loads it.
+// 8-bit colour PNG is written by libpng and float OpenEXR by OpenEXR without the module
+// (src/io/png_writer.h, exr_writer.h): a render that writes only those never loads it.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -60,22 +60,29 @@ TEST_F(ImageModuleCli, RenderWritesImagesThroughTheModuleItFindsItself) {
     EXPECT_EQ(forced.status, 0) << forced.err;
 }
 
-TEST_F(ImageModuleCli, AColourPngNeedsNoModule) {
-    const std::string png = dir_.file("frame.png"), through_module = dir_.file("frame.tif");
-    const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "'",
+TEST_F(ImageModuleCli, AColourPngAndExrAovsNeedNoModule) {
+    const std::string png = dir_.file("frame.png"), depth = dir_.file("depth.exr"), normal = dir_.file("normal.exr");
+    const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "' --depth '" + depth +
+                                                    "' --normal '" + normal + "'",
                                "OCTISO_IMAGE_MODULE=/nonexistent/liboctiso_images.so");
     ASSERT_EQ(r.status, 0) << r.err;
-    // The same pixels as OpenImageIO's own 8-bit writer gives the same frame.
-    ASSERT_EQ(run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + through_module + "'").status, 0);
-    const FloatImage a = read_image(png), b = read_image(through_module);
+    // The same pixels as OpenImageIO's own writers give the same frame (TIFF: 8-bit colour, float AOVs).
+    const std::string tif = dir_.file("frame.tif"), depth_tif = dir_.file("depth.tif"), normal_tif = dir_.file("normal.tif");
+    ASSERT_EQ(run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + tif + "' --depth '" + depth_tif +
+                                            "' --normal '" + normal_tif + "'")
+                  .status,
+              0);
+    const FloatImage a = read_image(png), b = read_image(tif);
     EXPECT_EQ(a.width, 40);
     EXPECT_EQ(a.channels, 3);
     EXPECT_EQ(a.pixels, b.pixels);
+    EXPECT_EQ(read_image(depth).pixels, read_image(depth_tif).pixels);
+    EXPECT_EQ(read_image(normal).pixels, read_image(normal_tif).pixels);
 }
 
 TEST_F(ImageModuleCli, AMissingModuleIsOneLineExitOneAndNoOutput) {
-    // A PNG colour image with a depth image beside it: the depth image needs the module.
-    const std::string png = dir_.file("frame.png"), exr = dir_.file("depth.exr");
+    // A PNG colour image with a TIFF depth image beside it: the TIFF needs the module.
+    const std::string png = dir_.file("frame.png"), exr = dir_.file("depth.tif");
     const ToolRun r = run_tool("octiso-render", "'" + oct_ + "' --iso 40.5 --size 40x30 -o '" + png + "' --depth '" + exr + "'",
                                "OCTISO_IMAGE_MODULE=/nonexistent/liboctiso_images.so");
     EXPECT_EQ(r.status, 1) << r.err;   // the installation, not the input (ErrorKind::Other)
