@@ -83,6 +83,8 @@ void write_colour_image(const std::string& path, const Frame& frame) {
 
 void write_depth_image(const std::string& path, const Frame& frame) {
     if (frame.depth.empty()) throw Error(path, "the frame has no depth image", ErrorKind::Other);
+    if (frame.depth.size() != size_t(frame.width) * size_t(frame.height))
+        throw Error(path, "the depth image is not width x height floats", ErrorKind::Other);
     const Pixel type = float_or_native(path);
     if (type == Pixel::f32) {
         write_image(path, frame.width, frame.height, 1, Pixel::f32, frame.depth.data(), {"Z"}, type);
@@ -100,6 +102,8 @@ void write_depth_image(const std::string& path, const Frame& frame) {
 
 void write_normal_image(const std::string& path, const Frame& frame) {
     if (frame.normal.empty()) throw Error(path, "the frame has no normal image", ErrorKind::Other);
+    if (frame.normal.size() != size_t(frame.width) * size_t(frame.height) * 3)
+        throw Error(path, "the normal image is not width x height x 3 floats", ErrorKind::Other);
     const Pixel type = float_or_native(path);
     if (type == Pixel::f32) {
         write_image(path, frame.width, frame.height, 3, Pixel::f32, frame.normal.data(), {"R", "G", "B"}, type);

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <random>
@@ -78,6 +79,14 @@ TEST(ExrWriter, DepthAndNormalWritersTakeEverySpellingOfExr) {
         EXPECT_EQ(n.channel_names, (std::vector<std::string>{"R", "G", "B"})) << name;
         EXPECT_TRUE(same_bits(n.pixels, f.normal)) << name;
     }
+    // Buffers of another size than the frame's are refused, not read past their end.
+    Frame short_depth = f;
+    short_depth.depth.pop_back();
+    EXPECT_THROW(write_depth_image(dir.file("short.exr"), short_depth), Error);
+    Frame short_normal = f;
+    short_normal.normal.pop_back();
+    EXPECT_THROW(write_normal_image(dir.file("short_n.exr"), short_normal), Error);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("short.exr")) || std::filesystem::exists(dir.file("short_n.exr")));
     EXPECT_TRUE(io::is_exr_path("x.exr") && io::is_exr_path("/a/b.ExR"));
     EXPECT_FALSE(io::is_exr_path("exr") || io::is_exr_path("x.exr.png") || io::is_exr_path("x.ex"));
 }
