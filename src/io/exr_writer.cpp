@@ -8,12 +8,12 @@
 #include <OpenEXR/ImfOutputFile.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cstring>
 #include <exception>
 #include <limits>
 #include <new>
 
+#include "io/file_extension.h"
 #include "octiso/error.h"
 
 namespace octiso::io {
@@ -41,12 +41,7 @@ private:
 
 }  // namespace
 
-bool is_exr_path(const std::string& path) {
-    if (path.size() < 4) return false;
-    std::string ext = path.substr(path.size() - 4);
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".exr";
-}
+bool is_exr_path(const std::string& path) { return has_extension(path, ".exr"); }
 
 std::vector<unsigned char> encode_float_exr(int width, int height, const float* pixels, const std::vector<std::string>& names,
                                             const std::string& what) {

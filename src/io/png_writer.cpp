@@ -7,12 +7,12 @@
 #include <png.h>
 
 #include <algorithm>
-#include <cctype>
 #include <csetjmp>
 #include <cstdio>
 #include <limits>
 #include <new>
 
+#include "io/file_extension.h"
 #include "octiso/error.h"
 
 namespace octiso::io {
@@ -76,12 +76,7 @@ bool encode(Sink& sink, int width, int height, const uint8_t* rgb, PngEffort eff
 
 }  // namespace
 
-bool is_png_path(const std::string& path) {
-    if (path.size() < 4) return false;
-    std::string ext = path.substr(path.size() - 4);
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".png";
-}
+bool is_png_path(const std::string& path) { return has_extension(path, ".png"); }
 
 std::vector<unsigned char> encode_rgb8_png(int width, int height, const uint8_t* rgb, PngEffort effort, const std::string& what) {
     // PNG's own limit is 2^31 - 1 a side; rows of 3 bytes a pixel must fit libpng's size type.
