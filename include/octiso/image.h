@@ -2,9 +2,10 @@
 // 8-bit sRGB unless the format is floating point; the depth AOV is one float channel named Z; the
 // normal AOV three float channels R,G,B. Every write goes to a temporary name renamed on success.
 // The colour image of a .png name (any case) is written by libpng and the depth and normal images
-// of an .exr name by OpenEXR, without OpenImageIO; everything else loads OpenImageIO on its first call (the module liboctiso_images.so, beside the tools in
-// the build tree, in lib/octiso when installed; $OCTISO_IMAGE_MODULE names another); if it cannot
-// be, the call throws Error(ErrorKind::Other) naming the module.
+// of an .exr name by OpenEXR, without OpenImageIO; everything else loads OpenImageIO on its first
+// call (the module liboctiso_images.so, beside the tools in the build tree, in lib/octiso when
+// installed; $OCTISO_IMAGE_MODULE names another); if it cannot be, the call throws
+// Error(ErrorKind::Other) naming the module.
 #pragma once
 
 #include <string>

@@ -12,8 +12,10 @@ namespace octiso::io {
 inline bool has_extension(const std::string& path, std::string_view ext) {
     if (path.size() < ext.size()) return false;
     const size_t start = path.size() - ext.size();
-    for (size_t i = 0; i < ext.size(); ++i)
-        if (std::tolower(static_cast<unsigned char>(path[start + i])) != std::tolower(static_cast<unsigned char>(ext[i]))) return false;
+    for (size_t i = 0; i < ext.size(); ++i) {
+        const int a = std::tolower(static_cast<unsigned char>(path[start + i]));
+        if (a != std::tolower(static_cast<unsigned char>(ext[i]))) return false;
+    }
     return true;
 }
 
