@@ -24,9 +24,16 @@ void write_image(const std::string& path, int width, int height, int channels, P
                  const std::vector<std::string>& names, Pixel file_type) {
     // Encode into memory, then write the bytes ourselves with every write checked: OIIO's PNG
     // writer did not report ENOSPC, and a truncated PNG was renamed into place (issue 18).
-    if (type == Pixel::f32 && file_type == Pixel::f32 && io::is_exr_path(path)) {   // OpenEXR, no module
+    // Colour PNG (libpng) and float OpenEXR (OpenEXR) without the module; check_image_path
+    // decides by the same rule.
+    if (type == Pixel::u8 && file_type == Pixel::u8 && channels == 3 && io::is_png_path(path)) {
+        const auto bytes = io::encode_rgb8_png(width, height, static_cast<const uint8_t*>(pixels), io::kPngFile, path);
+        write_file_atomically(path, bytes.data(), bytes.size());
+        return;
+    }
+    if (type == Pixel::f32 && file_type == Pixel::f32 && io::is_exr_path(path)) {
         OCTISO_CHECK(names.size() == size_t(channels), "one name per channel");
-        const std::vector<unsigned char> bytes = io::encode_float_exr(width, height, static_cast<const float*>(pixels), names, path);
+        const auto bytes = io::encode_float_exr(width, height, static_cast<const float*>(pixels), names, path);
         write_file_atomically(path, bytes.data(), bytes.size());
         return;
     }
@@ -73,11 +80,6 @@ void write_colour_image(const std::string& path, const Frame& frame) {
     if (frame.rgb.empty()) throw Error(path, "the frame has no colour image", ErrorKind::Other);
     if (frame.rgb.size() != size_t(frame.width) * size_t(frame.height) * 3)
         throw Error(path, "the colour image is not width x height x 3 bytes", ErrorKind::Other);
-    if (io::is_png_path(path)) {
-        const std::vector<unsigned char> bytes = io::encode_rgb8_png(frame.width, frame.height, frame.rgb.data(), io::kPngFile, path);
-        write_file_atomically(path, bytes.data(), bytes.size());
-        return;
-    }
     write_image(path, frame.width, frame.height, 3, Pixel::u8, frame.rgb.data(), {"R", "G", "B"}, Pixel::u8);
 }
 

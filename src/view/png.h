@@ -10,8 +10,8 @@
 namespace octiso::view {
 
 /// PNG of frame.rgb (width x height x 3) at io::kPngStream (zlib 1, unfiltered rows): at 1024^2
-/// the file settings cost more than the render, and the bytes only cross a socket. Throws Error(ErrorKind::Other) if the
-/// encoder fails.
+/// the file settings cost more than the render, and the bytes only cross a socket. Throws
+/// Error(ErrorKind::Other) if the encoder fails.
 std::string encode_png(const Frame& frame);
 
 }  // namespace octiso::view
