@@ -384,12 +384,15 @@ public:
 
     /// Value of voxel p, starting the descent at node `index` of depth `depth` <= dmax-2.
     /// Precondition: p lies inside that node's cube. Knoll 2006 App. B.1, with the child octant
-    /// built by bitwise or (the paper's `||` is a slip).
-    OCTISO_ALWAYS_INLINE LeafRef<T> locate_from(Coord p, int depth, uint32_t index) const {
+    /// built by bitwise or (the paper's `||` is a slip). `side`, when given, receives the side of
+    /// the scalar leaf or cap the descent ended in: the aligned cube of that side around p, whose
+    /// every voxel the same reference yields.
+    OCTISO_ALWAYS_INLINE LeafRef<T> locate_from(Coord p, int depth, uint32_t index, uint32_t* side = nullptr) const {
         const int cap_parents_at = a_.dmax - 2;
         for (;;) {
             const InteriorNode<T>& n = a_.nodes[size_t(depth)][index];
             const int c = octant_of(p, child_bit(depth));
+            if (side) *side = child_bit(depth);
             if (n.is_scalar_leaf(c)) return {n.scalar[c], false, {}, 0};
             if (depth == cap_parents_at) return {T{}, true, this->cap(index, n, c), octant_of(p, 1u)};
             index = child_index(depth, index, n, c);
@@ -409,9 +412,11 @@ public:
     }
     /// The same, returning where the descent ended (the traversal then reads a whole forward
     /// neighbour block directly).
-    OCTISO_ALWAYS_INLINE LeafRef<T> neighbour_locate(Coord start, Coord dest, int depth, const uint32_t* parent_trace) const {
+    /// `side` as for locate_from.
+    OCTISO_ALWAYS_INLINE LeafRef<T> neighbour_locate(Coord start, Coord dest, int depth, const uint32_t* parent_trace,
+                                                     uint32_t* side = nullptr) const {
         const TracedNode from = common_ancestor(start, dest, depth, parent_trace);
-        return locate_from(dest, from.depth, from.index);
+        return locate_from(dest, from.depth, from.index, side);
     }
 
     /// A node on a parent trace: its depth and its index there.

@@ -1064,6 +1064,32 @@ private:
         const double v = double(value);
         const bool leaf_on_ghost = restricted_ && ghost_ && co.x + side == owned_.hi[0];
         const bool partial = restricted_ && !inside_owned(co, side);   // cells outside the box skipped
+        // The outer corners of the shell cells (beyond the leaf) come from the scalar leaf or cap
+        // that held the last one read, while they lie in it: a shell cell's 4-7 outer corners and
+        // the next cell's mostly lie in one neighbour, found by one descent instead of one each.
+        // Only voxels of that neighbour are read from it, so every corner is the one a descent of
+        // its own finds (RenderAgreement.BigLeavesBesideNoisyCapsReadEveryOuterCorner). aal @0.5,
+        // where such shells are common: 0.970 / 0.979 x the trace at the minimum in two runs (9
+        // and 11 pairs, build_ab_beyond_leaf_first.json, build_ab_beyond_leaf.json); ch2better,
+        // ch2, plume and mixing 0.98-1.01 x. One memo shared by the lanes of a packet crossing the
+        // leaf was 1.014-1.018 x this per-ray one (15 pairs, build_ab_beyond_leaf_shared_by_lanes.json).
+        struct {
+            Coord o{~0u, ~0u, ~0u};
+            uint32_t keep = 0;   // ~(side - 1) of the neighbour at o; 0: none yet
+            LeafRef<T> ref{};
+        } beyond;
+        auto beyond_value = [&](Coord p, Coord dest) OCTISO_LAMBDA_INLINE {
+            if ((dest.x & beyond.keep) != beyond.o.x || (dest.y & beyond.keep) != beyond.o.y ||
+                (dest.z & beyond.keep) != beyond.o.z) {
+                uint32_t found_side = 1;
+                beyond.ref = tree_.neighbour_locate(p, dest, holder_depth, trace, &found_side);
+                beyond.keep = ~(found_side - 1);
+                beyond.o = {dest.x & beyond.keep, dest.y & beyond.keep, dest.z & beyond.keep};
+            } else if (beyond.ref.in_cap) {
+                beyond.ref.octant = octant_of(dest, 1u);
+            }
+            return double(beyond.ref.voxel());
+        };
         auto gather = [&](Coord p, double corner[8]) {
             if constexpr (!kOwnCorners) {
                 corners_.gather(p, corner);
@@ -1075,7 +1101,7 @@ private:
                 const Coord dest{p.x + (k & 1), p.y + ((k >> 1) & 1), p.z + ((k >> 2) & 1)};
                 corner[k] = (dest.x < ex && dest.y < ey && dest.z < ez) ? v
                             : (on_ghost && (k & 1))                     ? ghost_value(p, k)
-                                                                        : double(tree_.neighbour_find(p, dest, holder_depth, trace));
+                                                                        : beyond_value(p, dest);
             }
         };
         bool iso_equals_value = false;

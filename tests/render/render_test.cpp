@@ -94,6 +94,43 @@ TYPED_TEST(RenderAgreement, BlockyLabelsWithBigLeavesBetweenIsovalues) {
     }
 }
 
+/// Big scalar leaves (labels 0, 10, 30 in blocks of side 4 to 32) beside blocks of noise (label
+/// 20 drawn per voxel from 14 .. 26, so their caps hold 8 different voxels): a leaf's shell cells
+/// read their outer corners from those caps, one voxel each, through the neighbour the walk
+/// found last while the next corner lies in it. A corner read from the right cap but the wrong
+/// voxel (a stale octant) moves the surface there, which the labels-only test above, whose
+/// neighbours are uniform, cannot see. Single rays and packets, against the dense reference.
+TYPED_TEST(RenderAgreement, BigLeavesBesideNoisyCapsReadEveryOuterCorner) {
+    using T = TypeParam;
+    const Dims dims{70, 61, 66};
+    DenseVolume<T> v = nested_label_blocks<T>(dims, 11);
+    uint32_t state = 12345u, noisy = 0;
+    for (T& x : v.values) {
+        state = state * 1664525u + 1013904223u;
+        if (x == T(20)) x = T(14 + int((state >> 16) % 13u)), ++noisy;
+    }
+    ASSERT_GT(noisy, v.values.size() / 10);
+    Placement placement;
+    const std::array<double, 3> centre{34.5, 30, 32.5};
+    for (const Traversal traversal : {Traversal::single, Traversal::packets})
+        for (double iso : {5.0, 15.5, 27.5})
+            for (int o = 0; o < 8; o += 5) {
+                const std::array<double, 3> eye{centre[0] + ((o & 1) ? 90 : -90), centre[1] + ((o & 2) ? 80 : -80),
+                                                centre[2] + ((o & 4) ? 75 : -75)};
+                const Camera camera = look_at(eye, centre, {0, 0, 1}, 40, 64);
+                const auto data = build_octree(v.view(), {});
+                RenderOptions options;
+                options.isovalues = {iso};
+                options.want_colour = false;
+                options.want_depth = true;
+                options.traversal = traversal;
+                const Frame frame = render(data.view(), placement, camera, options);
+                expect_agreement(error_against_reference(frame, v.view(), placement, camera, iso),
+                                 std::string(traversal == Traversal::single ? "single" : "packets") + " iso " +
+                                     std::to_string(iso) + " octant " + std::to_string(o));
+            }
+}
+
 TEST(RenderAgreementFields, NoiseSierpinskiTorusOddShapes) {
     const struct { Field field; Dims dims; double iso; } cases[] = {
         {Field::Noise, {17, 21, 13}, 56.0}, {Field::Sierpinski, {27, 27, 27}, 60.0},
