@@ -1072,7 +1072,9 @@ private:
         // where such shells are common: 0.970 / 0.979 x the trace at the minimum in two runs (9
         // and 11 pairs, build_ab_beyond_leaf_first.json, build_ab_beyond_leaf.json); ch2better,
         // ch2, plume and mixing 0.98-1.01 x. One memo shared by the lanes of a packet crossing the
-        // leaf was 1.014-1.018 x this per-ray one (15 pairs, build_ab_beyond_leaf_shared_by_lanes.json).
+        // leaf took 1.014-1.018 x the time of this per-ray one at the minimum (15 pairs,
+        // build_ab_beyond_leaf_shared_by_lanes.json); keeping the last cap's parent as well,
+        // 1.009-1.045 x (build_ab_beyond_leaf_cap_parent.json).
         struct {
             Coord o{~0u, ~0u, ~0u};
             uint32_t keep = 0;   // ~(side - 1) of the neighbour at o; 0: none yet

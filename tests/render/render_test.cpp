@@ -110,19 +110,19 @@ TYPED_TEST(RenderAgreement, BigLeavesBesideNoisyCapsReadEveryOuterCorner) {
         if (x == T(20)) x = T(14 + int((state >> 16) % 13u)), ++noisy;
     }
     ASSERT_GT(noisy, v.values.size() / 10);
+    const auto data = build_octree(v.view(), {});
     Placement placement;
     const std::array<double, 3> centre{34.5, 30, 32.5};
+    RenderOptions options;
+    options.want_colour = false;
+    options.want_depth = true;
     for (const Traversal traversal : {Traversal::single, Traversal::packets})
         for (double iso : {5.0, 15.5, 27.5})
             for (int o = 0; o < 8; o += 5) {
                 const std::array<double, 3> eye{centre[0] + ((o & 1) ? 90 : -90), centre[1] + ((o & 2) ? 80 : -80),
                                                 centre[2] + ((o & 4) ? 75 : -75)};
                 const Camera camera = look_at(eye, centre, {0, 0, 1}, 40, 64);
-                const auto data = build_octree(v.view(), {});
-                RenderOptions options;
                 options.isovalues = {iso};
-                options.want_colour = false;
-                options.want_depth = true;
                 options.traversal = traversal;
                 const Frame frame = render(data.view(), placement, camera, options);
                 expect_agreement(error_against_reference(frame, v.view(), placement, camera, iso),
