@@ -54,9 +54,11 @@ struct RecordingFinder {
     std::vector<CellCall>* calls = nullptr;
 };
 
-/// The last parameter is nearest_root's deferred-refinement bracket, which only Neubauer fills.
+/// The last two parameters are nearest_root's deferred-refinement bracket, which only Neubauer
+/// fills, and what it knows of the corners (cell.h), which changes no root.
+template <class CornerKind = AnyCorners>
 double first_root(const RecordingFinder& r, const double corner[8], double iso, const std::array<double, 3>& p_in,
-                  const std::array<double, 3>& p_out, bool closed_end, RootBracket* = nullptr) {
+                  const std::array<double, 3>& p_out, bool closed_end, RootBracket* = nullptr, CornerKind = {}) {
     CellCall c;
     std::copy(corner, corner + 8, c.corner);
     c.iso = iso, c.p_in = p_in, c.p_out = p_out, c.closed_end = closed_end;

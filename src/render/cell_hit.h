@@ -116,7 +116,8 @@ OCTISO_ALWAYS_INLINE void set_hit_at(RayState& w, double s, const double corner[
 /// in its bracket, inside [0, 1)), so its refinement, t and normal can wait: `w.later` keeps what
 /// they need, w.pending is set, and finish_hit (pending_roots.h) later gives the same hit bit
 /// for bit. A packet then refines its lanes' roots four at a time.
-template <class Finder, bool kDefer = false>
+/// CornerKind: IntegerCorners where the corners are values of an integer scalar type (cell.h).
+template <class Finder, bool kDefer = false, class CornerKind = AnyCorners>
 inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RayState& w, const double corner[8], double lo, double hi,
                          const std::array<double, 3>& p_in, const std::array<double, 3>& p_out, double t_in, double t_out,
                          bool closed_end, const std::array<double, 3>& cell_spacing) {
@@ -130,7 +131,7 @@ inline bool nearest_root(const Finder& finder, const CellWalkScene& scene, RaySt
     for (int i = 0; i < scene.iso_count; ++i) {
         const double iso = scene.isovalues[i];
         if (!(lo <= iso && iso <= hi)) continue;
-        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end, later);
+        const double s = first_root(finder, corner, iso, p_in, p_out, closed_end, later, CornerKind{});
         // Only with `later`: the one isovalue's root, refined by finish_hit(s) (pending_roots.h).
         // The other instantiations never see kRootPending and compile the test away.
         if (kMayDefer && s == kRootPending) {
@@ -157,7 +158,7 @@ OCTISO_ALWAYS_INLINE void corner_range(const double corner[8], double& lo, doubl
 
 /// intersect_cell after its cull, for a caller that has the corners' range [lo, hi] already (a
 /// packet's cell, culled once for all its lanes): the same root, bit for bit.
-template <class Finder, bool kDefer = false>
+template <class Finder, bool kDefer = false, class CornerKind = AnyCorners>
 OCTISO_ALWAYS_INLINE bool intersect_cell_in_range(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
                                                   const double corner[8], double lo, double hi, double t_in, double t_out,
                                                   bool closed_end) {
@@ -171,19 +172,20 @@ OCTISO_ALWAYS_INLINE bool intersect_cell_in_range(const Finder& finder, const Ce
         p_in[a] = snap_to_face(o_cell[a] + t_in * r.dir[a]);
         p_out[a] = snap_to_face(o_cell[a] + t_out * r.dir[a]);
     }
-    return nearest_root<Finder, kDefer>(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end,
-                                        scene.placement.spacing);
+    return nearest_root<Finder, kDefer, CornerKind>(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out,
+                                                    closed_end, scene.placement.spacing);
 }
 
 /// Tests cell v (lower corner, index space) with corners `corner` (order i + 2j + 4k) on the ray
 /// piece [t_in, t_out) ([t_in, t_out] when closed_end). On a hit fills `w.hit` and returns true.
-template <class Finder, bool kDefer = false>
+template <class Finder, bool kDefer = false, class CornerKind = AnyCorners>
 inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
                            const double corner[8], double t_in, double t_out, bool closed_end) {
     double lo, hi;
     corner_range(corner, lo, hi);
     if (!scene.any_iso_in(lo, hi)) return false;   // a NaN corner fails every comparison
-    return intersect_cell_in_range<Finder, kDefer>(finder, scene, w, v, corner, lo, hi, t_in, t_out, closed_end);
+    return intersect_cell_in_range<Finder, kDefer, CornerKind>(finder, scene, w, v, corner, lo, hi, t_in, t_out,
+                                                               closed_end);
 }
 
 /// Level of detail (lod.h): intersect_cell on the coarse cell with lower corner v and sides
@@ -191,7 +193,7 @@ inline bool intersect_cell(const Finder& finder, const CellWalkScene& scene, Ray
 /// 8 vertices. The segment is mapped into the unit cube by dividing by the extent, and the
 /// normal's gradient is per world unit through spacing x extent. A separate function so that the
 /// exact path keeps its arithmetic bit for bit.
-template <class Finder, bool kDefer = false>
+template <class Finder, bool kDefer = false, class CornerKind = AnyCorners>
 inline bool intersect_coarse_cell(const Finder& finder, const CellWalkScene& scene, RayState& w, const Coord& v,
                                   const uint32_t extent[3], const double corner[8], double t_in, double t_out,
                                   bool closed_end) {
@@ -208,7 +210,8 @@ inline bool intersect_coarse_cell(const Finder& finder, const CellWalkScene& sce
         p_out[a] = snap_to_face((o + t_out * r.dir[a]) / e);
         cell_spacing[a] = scene.placement.spacing[a] * e;
     }
-    return nearest_root<Finder, kDefer>(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out, closed_end, cell_spacing);
+    return nearest_root<Finder, kDefer, CornerKind>(finder, scene, w, corner, lo, hi, p_in, p_out, t_in, t_out,
+                                                    closed_end, cell_spacing);
 }
 
 OCTISO_ISA_END

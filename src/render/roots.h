@@ -340,16 +340,22 @@ inline double marmitt_walk(const Finder& finder, const CellCubic<typename Finder
 ///   - a root exactly at s = 1 (f_out == 0) belongs to the next cell unless closed_end.
 /// Pure function of its arguments; thread-safe.
 /// With `later` (Neubauer only): kRootPending where the root needs refining, its bracket in *later.
-template <class Finder>
+/// IntegerCorners (cell.h): the caller vouches for finite corners and iso, and the cubic skips its
+/// scaling; the same root bit for bit.
+template <class Finder, class CornerKind = AnyCorners>
 inline double first_root(const Finder& finder, const double corner[8], double iso, const std::array<double, 3>& p_in,
-                         const std::array<double, 3>& p_out, bool closed_end, RootBracket* later = nullptr) {
+                         const std::array<double, 3>& p_out, bool closed_end, RootBracket* later = nullptr,
+                         CornerKind kind = {}) {
     using R = typename Finder::Real;
-    bool finite = std::isfinite(iso);
-    for (int i = 0; i < 8; ++i) finite &= std::isfinite(corner[i]);
+    bool finite = true;
+    if constexpr (!std::is_same_v<CornerKind, IntegerCorners>) {
+        finite = std::isfinite(iso);
+        for (int i = 0; i < 8; ++i) finite &= std::isfinite(corner[i]);
+    }
     for (int a = 0; a < 3; ++a) finite &= std::isfinite(p_in[a]) && std::isfinite(p_out[a]);
     if (!finite) return kNoHit;
 
-    const CellCubic<R> f = make_cell_cubic<R>(corner, iso, p_in, p_out);
+    const CellCubic<R> f = make_cell_cubic<R>(corner, iso, p_in, p_out, kind);
     if (p_in == p_out) return closed_end && f.f_in == 0 ? 0.0 : kNoHit;
     if (f.f_in == 0) return 0.0;
     // 0.94-0.96 x the frame time (min of 5 interleaved pairs; build_ab_bernstein_exit.json).

@@ -115,6 +115,9 @@ public:
     /// refinement alone, normals one by one, 0.99-1.01 x at the minimum in a 21-pair run
     /// (build_ab_deferred_refine_only.json): the normals' divisions and square root are the gain.
     static constexpr bool kDeferRoots = !Recorder::kOn;
+    /// Every corner a traversal of an integer file tests is one of its voxels (or, at a coarse
+    /// level, a stored scalar of its type), so the cell's cubic skips its scaling (cell.h).
+    using CornerKind = std::conditional_t<std::is_integral_v<T>, IntegerCorners, AnyCorners>;
 
     /// The most rays one trace_packet() call takes (packet_size.h).
     static constexpr int kMaxPacket = kMaxTracePacket;
@@ -786,8 +789,8 @@ private:
             for (unsigned m = entered; m; m &= m - 1) {
                 const int k = std::countr_zero(m);
                 Walk& w = p.lane[k];
-                if (intersect_cell_in_range<Finder, kDeferRoots>(finder_, scene_, w, v, corner, lo, hi, c0[k], c1[k],
-                                                                 c1[k] == w.t_exit))
+                if (intersect_cell_in_range<Finder, kDeferRoots, CornerKind>(finder_, scene_, w, v, corner, lo, hi, c0[k],
+                                                                             c1[k], c1[k] == w.t_exit))
                     active &= ~(1u << k);
             }
         }
@@ -1235,7 +1238,9 @@ private:
         const bool closed_end = t1 == w.t_exit;
         if (!(t1 > t0 || closed_end)) return false;
         const uint32_t extent[3] = {side, side, side};
-        if (!intersect_coarse_cell<Finder, kDeferRoots>(finder_, scene_, w, co, extent, corner, t0, t1, closed_end)) return false;
+        if (!intersect_coarse_cell<Finder, kDeferRoots, CornerKind>(finder_, scene_, w, co, extent, corner, t0, t1,
+                                                                    closed_end))
+            return false;
         w.hit.cell_log2 = std::countr_zero(side);
         return true;
     }
@@ -1303,7 +1308,8 @@ private:
                                   corner[k] = double(tree_.lattice_value(co, p, at, d, trace));
                               }
                               const Coord v{q[0], q[1], q[2]};
-                              if (!intersect_coarse_cell<Finder, kDeferRoots>(finder_, scene_, w, v, e, corner, t_in, t_out, closed_end))
+                              if (!intersect_coarse_cell<Finder, kDeferRoots, CornerKind>(finder_, scene_, w, v, e, corner,
+                                                                                          t_in, t_out, closed_end))
                                   return false;
                               w.hit.cell_log2 = shift;
                               return true;
@@ -1330,7 +1336,7 @@ private:
             if (hit) recorder_.root(w.hit.t, w.hit.iso_index);
             return hit;
         }
-        return intersect_cell<Finder, kDeferRoots>(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
+        return intersect_cell<Finder, kDeferRoots, CornerKind>(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
     }
 
     const Octree<T> tree_;   // a view: cheap to copy, and no dangling reference to a temporary

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <random>
 
 #include "render/cell.h"
@@ -55,6 +56,36 @@ TEST(CellCubic, LongDoubleAgreesWithDouble) {
         ASSERT_EQ(fd.scale_exp, fl.scale_exp);   // the same power of two unless at a binade edge
         for (int i = 0; i < 4; ++i) EXPECT_NEAR(fd.c[i], double(fl.c[i]), 1e-14);
     }
+}
+
+/// IntegerCorners (values of an integer type, the isovalue inside their range) skips the scaling
+/// of step 1: the same cubic bit for bit, its scale exponent included, in double and long double.
+template <typename R> void expect_integer_corners_unscaled_bit_for_bit(uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u01(0, 1);
+    for (int n = 0; n < 20000; ++n) {
+        const double top = n % 3 == 0 ? 255.0 : n % 3 == 1 ? 65535.0 : 4294967295.0;
+        const double offset = n % 2 ? 0.0 : -std::floor(top / 2) - 1;   // signed types too
+        double c[8], lo = 1e300, hi = -1e300;
+        for (double& v : c) v = std::floor(u01(rng) * top) + offset, lo = std::min(lo, v), hi = std::max(hi, v);
+        const double iso = n % 5 == 0 ? c[n % 8] : lo + (hi - lo) * u01(rng);
+        P3 p_in, p_out;
+        for (int a = 0; a < 3; ++a) p_in[a] = u01(rng), p_out[a] = u01(rng);
+        if (n % 7 == 0) p_out[n % 3] = p_in[n % 3];
+        const CellCubic<R> scaled = make_cell_cubic<R>(c, iso, p_in, p_out, AnyCorners{});
+        const CellCubic<R> unscaled = make_cell_cubic<R>(c, iso, p_in, p_out, IntegerCorners{});
+        // Equal values of equal sign (long double's padding bytes are not its value).
+        auto same = [](R a, R b) { return a == b && std::signbit(a) == std::signbit(b); };
+        ASSERT_EQ(scaled.scale_exp, unscaled.scale_exp) << n;
+        for (int i = 0; i < 4; ++i) ASSERT_TRUE(same(scaled.c[i], unscaled.c[i])) << n << " c" << i;
+        ASSERT_TRUE(same(scaled.f_out, unscaled.f_out)) << n;
+        ASSERT_TRUE(same(scaled.f_in, unscaled.f_in)) << n;
+    }
+}
+
+TEST(CellCubic, IntegerCornersSkipTheScalingBitForBit) {
+    expect_integer_corners_unscaled_bit_for_bit<double>(11);
+    expect_integer_corners_unscaled_bit_for_bit<long double>(12);
 }
 
 TEST(CellCubic, ConstantCellEqualToIsoIsIdenticallyZeroAtAnyScale) {

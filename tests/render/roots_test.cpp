@@ -540,6 +540,81 @@ TYPED_TEST(RootFinder, EarlyExitReturnsWhatTheWalkReturns) {
     EXPECT_GT(fired_at_edge, 1000);
 }
 
+/// What the octree traversal of an integer file vouches for (IntegerCorners, cell.h: voxels of
+/// an integer type, the isovalue inside their range) lets the cubic skip its scaling; every root,
+/// pending bracket and miss must stay the one of the scaled path, bit for bit, for all four
+/// integer ranges, isovalues on and between the values, and stiff segments (zero length, on a
+/// face, nearly axis-parallel, near a tangent).
+TYPED_TEST(RootFinder, IntegerCornersGiveTheSameRootBitForBit) {
+    std::mt19937_64 rng(20261207);
+    std::uniform_real_distribution<double> u01(0, 1);
+    const double ranges[][2] = {{0, 255}, {-32768, 32767}, {0, 4294967295.0}, {-2147483648.0, 2147483647.0}, {0, 3}};
+    int cases = 0, hits = 0, pending = 0;
+    auto check = [&](const Seg& g) {
+        ++cases;
+        RootBracket any_later{}, int_later{};
+        const bool defer = std::is_same_v<TypeParam, Neubauer>;
+        const double any = first_root(TypeParam{}, g.corner, g.iso, g.p_in, g.p_out, cases % 3 == 0,
+                                      defer ? &any_later : nullptr, AnyCorners{});
+        const double integer = first_root(TypeParam{}, g.corner, g.iso, g.p_in, g.p_out, cases % 3 == 0,
+                                          defer ? &int_later : nullptr, IntegerCorners{});
+        ASSERT_EQ(std::memcmp(&any, &integer, sizeof any), 0) << "case " << cases << ": " << any << " vs " << integer;
+        if (any == kRootPending) {
+            ++pending;
+            ASSERT_EQ(std::memcmp(&any_later, &int_later, sizeof any_later), 0) << "bracket of case " << cases;
+        }
+        hits += any >= 0 || any == kRootPending;
+    };
+    for (int n = 0; n < 40000; ++n) {
+        const auto& r = ranges[n % 5];
+        std::uniform_int_distribution<int64_t> value{int64_t(r[0]), int64_t(r[1])};
+        Seg g;
+        // Narrow cells as well as wide ones: a base value and small offsets, clamped to the type.
+        const int64_t base = value(rng), spread = int64_t(1) << (n % 33);
+        double lo = 1e300, hi = -1e300;
+        for (double& c : g.corner) {
+            const int64_t v = std::clamp<int64_t>(base + int64_t(u01(rng) * double(spread)) - spread / 2, int64_t(r[0]),
+                                                  int64_t(r[1]));
+            c = double(v), lo = std::min(lo, c), hi = std::max(hi, c);
+        }
+        switch (n % 4) {
+            case 0: g.iso = lo + (hi - lo) * u01(rng); break;
+            case 1: g.iso = std::floor(lo + (hi - lo) * u01(rng)) + 0.5; break;
+            case 2: g.iso = g.corner[n % 8]; break;   // on a voxel value
+            default: g.iso = lo + (hi - lo) * std::ldexp(u01(rng), -40); break;
+        }
+        if (g.iso > hi) g.iso = hi;   // the traversal tests only isovalues inside the range
+        for (int a = 0; a < 3; ++a) g.p_in[a] = u01(rng), g.p_out[a] = u01(rng);
+        switch (n % 6) {
+            case 0: g.p_out = g.p_in; break;                                       // zero length
+            case 1: g.p_in[n % 3] = 0, g.p_out[n % 3] = 1; break;                  // face to face
+            case 2: g.p_in[0] = 1e-12, g.p_out[0] = 1e-12 + 1e-27, g.p_out[1] = g.p_in[1]; break;   // the
+                // shortest non-zero move along an axis that snap_to_face leaves (cell_hit.h)
+            case 3: g.p_out[2] = g.p_in[2] * (1 + 1e-15); break;
+            default: break;
+        }
+        check(g);
+        // Near a tangent: the isovalue at a stationary point of the segment, nudged by ulps.
+        const CellCubic<double> f0 = make_cell_cubic<double>(g.corner, 0.0, g.p_in, g.p_out);
+        double ext[2];
+        const int m = roots_detail::extrema_stable(f0, ext);
+        for (int i = 0; i < m; ++i) {
+            P3 p;
+            for (int a = 0; a < 3; ++a) p[a] = g.p_in[a] + ext[i] * (g.p_out[a] - g.p_in[a]);
+            const double v = trilinear(g.corner, p);
+            for (double k : {0.0, 1.0, -1.0, 64.0}) {
+                Seg t = g;
+                t.iso = std::clamp(v + k * std::ldexp(std::fabs(v) + 1e-300, -52), lo, hi);
+                check(t);
+            }
+        }
+    }
+    EXPECT_GT(hits, cases / 20) << "the cases should hit often enough to compare roots (Linear: 7-8 %)";
+    if (std::is_same_v<TypeParam, Neubauer>) {
+        EXPECT_GT(pending, 1000);
+    }
+}
+
 TEST(RootFinderReference, ExactMatchesIndependentFloat128Reference) {
     std::mt19937_64 rng(20060101);
     std::uniform_real_distribution<double> u01(0, 1), usym(-1, 1);
