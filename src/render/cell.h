@@ -79,7 +79,10 @@ struct IntegerCorners {};
 /// Invariants: f_in == c[0] (direct trilinear at p_in) and f_out is the direct trilinear value at
 /// p_out under the same scaling, so the endpoint signs agree with the neighbouring cells (their
 /// shared face values are bitwise equal) even where Horner at s = 1 would round the other way.
-/// max(|c[i]|, |f_out|) is in [1/2, 1) unless everything is 0 (f identically iso on the segment).
+/// max(|c[i]|, |f_out|) is in [1/2, 1) unless everything is 0 (f identically iso on the segment),
+/// except for IntegerCorners (make_cell_cubic): there scale_exp is 0 and nothing is normalised.
+/// Every finder is homogeneous in the coefficients (its guards relative, its steps ratios, sign
+/// tests and halvings), so a power of two more or less changes no root it returns.
 template <typename R> struct CellCubic {
     R c[4];
     R f_in, f_out;
@@ -94,15 +97,18 @@ template <typename R> struct CellCubic {
 /// arithmetic R (double for the fast finders, long double for the reference). Preconditions: all
 /// inputs finite. Never overflows: corners and iso are first scaled by 2^-e with 2^e > max(|corner|,
 /// |iso|) (exact: a power of two), so c - iso == 0 exactly where corner == iso, whatever the scale.
-/// IntegerCorners (their magnitudes at most 2^32, nothing to overflow) skips that scaling: the
-/// same cubic bit for bit, because multiplying by a power of two commutes with the rounding of
-/// every +, - and * below as long as no value leaves the normal range, and step 3 divides by the
-/// same power of two in the end. Only a value that the scaling (by at most 2^-33) would push
-/// below 2^-1022 could differ, the unscaled one being the more exact; the traversal's segment
-/// ends are 0, 1 or at least 1e-12 from a face (snap_to_face), so its smallest non-zero
-/// intermediate is far above that. Without the 9 magnitudes, the exponent and the 9 products:
-/// 0.947-0.981 x the trace at the minimum on the real scans, 0.962 / 0.969 on plume / mixing
-/// 256^3 (11 pairs, build_ab_integer_corners.json).
+/// IntegerCorners (their magnitudes at most 2^32, nothing to overflow) skips that scaling and
+/// the normalisation of step 3 (scale_exp 0): the scaled cubic times a power of two, exactly,
+/// because multiplying by a power of two commutes with the rounding of every +, - and * below as
+/// long as no value leaves the normal range. Only a value that the scaling (by at most 2^-33)
+/// would push below 2^-1022 could differ, the unscaled one being the more exact; the traversal's
+/// segment ends are 0, 1 or at least 1e-12 from a face (snap_to_face), so its smallest non-zero
+/// intermediate is far above that, and the coefficients stay below 2^40, far from overflow in
+/// the finders' squares. Every root the same bit for bit (CellCubic above). Step 1 without its 9
+/// magnitudes, exponent and 9 products: 0.947-0.981 x the trace at the minimum on the real scans,
+/// 0.962 / 0.969 on plume / mixing 256^3 (11 pairs, build_ab_integer_corners.json); step 3
+/// without its 5 magnitudes, exponent and 5 products, on top of that: 0.935-0.980 x
+/// (9 pairs, build_ab_integer_corners_unnormalised.json).
 template <typename R, class CornerKind = AnyCorners>
 inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const std::array<double, 3>& p_in,
                                     const std::array<double, 3>& p_out, CornerKind = {}) {
@@ -138,6 +144,11 @@ inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const st
     f.c[3] = k7 * dx * dy * dz;
     f.f_out = trilinear<R>(g, R(p_out[0]), R(p_out[1]), R(p_out[2]));
 
+    if constexpr (std::is_same_v<CornerKind, IntegerCorners>) {   // step 3 changes no root
+        f.f_in = f.c[0];
+        f.scale_exp = 0;
+        return f;
+    }
     // 3. Normalise so the largest magnitude lies in [1/2, 1): exact, signs and zeros preserved.
     R big = std::fabs(f.f_out);
     for (int i = 0; i < 4; ++i) big = std::max(big, std::fabs(f.c[i]));
