@@ -485,6 +485,21 @@ TYPED_TEST(RootFinder, E16_SliverThroughAnEdgeReportedByExactlyOneCell) {
 /// a sign change) and on cells whose hull clears zero by a hair around the exit's margin (the
 /// isovalue just below the smallest or above the largest Bernstein coefficient). The exit must
 /// fire on random and on hull-edge cells (not a vacuous check).
+/// The field's values at the stationary points of segment g inside (0, 1): where an isovalue
+/// makes the segment touch the surface.
+std::vector<double> stationary_values(const Seg& g) {
+    const CellCubic<double> f0 = make_cell_cubic<double>(g.corner, 0.0, g.p_in, g.p_out);
+    double ext[2];
+    const int m = roots_detail::extrema_stable(f0, ext);
+    std::vector<double> values;
+    for (int i = 0; i < m; ++i) {
+        P3 p;
+        for (int a = 0; a < 3; ++a) p[a] = g.p_in[a] + ext[i] * (g.p_out[a] - g.p_in[a]);
+        values.push_back(trilinear(g.corner, p));
+    }
+    return values;
+}
+
 TYPED_TEST(RootFinder, EarlyExitReturnsWhatTheWalkReturns) {
     using R = typename TypeParam::Real;
     std::mt19937_64 rng(19980101);
@@ -512,18 +527,12 @@ TYPED_TEST(RootFinder, EarlyExitReturnsWhatTheWalkReturns) {
         check(g, false);
         // Near-tangent: iso at the field's value at a stationary point of the segment, nudged by ulps.
         const CellCubic<double> f0 = make_cell_cubic<double>(g.corner, 0.0, g.p_in, g.p_out);
-        double ext[2];
-        const int m = roots_detail::extrema_stable(f0, ext);
-        for (int i = 0; i < m; ++i) {
-            P3 p;
-            for (int a = 0; a < 3; ++a) p[a] = g.p_in[a] + ext[i] * (g.p_out[a] - g.p_in[a]);
-            const double v = trilinear(g.corner, p);
+        for (double v : stationary_values(g))
             for (double k : {0.0, 1.0, -1.0, 8.0, -8.0, 4096.0, -4096.0}) {
                 Seg t = g;
                 t.iso = v + k * std::ldexp(std::fabs(v) + 1e-300, -52);
                 check(t, false);
             }
-        }
         // Hull edge: the Bernstein coefficients of f - iso are those of f shifted by iso (scaled).
         const std::array<double, 4> b = roots_detail::bernstein_on_unit(f0);
         const double scale = std::ldexp(1.0, f0.scale_exp);
@@ -600,19 +609,12 @@ TYPED_TEST(RootFinder, IntegerCornersGiveTheSameRootBitForBit) {
         }
         check(g);
         // Near a tangent: the isovalue at a stationary point of the segment, nudged by ulps.
-        const CellCubic<double> f0 = make_cell_cubic<double>(g.corner, 0.0, g.p_in, g.p_out);
-        double ext[2];
-        const int m = roots_detail::extrema_stable(f0, ext);
-        for (int i = 0; i < m; ++i) {
-            P3 p;
-            for (int a = 0; a < 3; ++a) p[a] = g.p_in[a] + ext[i] * (g.p_out[a] - g.p_in[a]);
-            const double v = trilinear(g.corner, p);
+        for (double v : stationary_values(g))
             for (double k : {0.0, 1.0, -1.0, 64.0}) {
                 Seg t = g;
                 t.iso = std::clamp(v + k * std::ldexp(std::fabs(v) + 1e-300, -52), lo, hi);
                 check(t);
             }
-        }
     }
     EXPECT_GT(hits, cases / 20) << "the cases should hit often enough to compare roots (Linear: 7-8 %)";
     if (std::is_same_v<TypeParam, Neubauer>) {
