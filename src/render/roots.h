@@ -340,8 +340,8 @@ inline double marmitt_walk(const Finder& finder, const CellCubic<typename Finder
 ///   - a root exactly at s = 1 (f_out == 0) belongs to the next cell unless closed_end.
 /// Pure function of its arguments; thread-safe.
 /// With `later` (Neubauer only): kRootPending where the root needs refining, its bracket in *later.
-/// IntegerCorners (cell.h): the caller vouches for finite corners and iso, and the cubic skips its
-/// scaling; the same root bit for bit.
+/// IntegerCorners (cell.h): the caller vouches for corners of an integer type and an iso inside
+/// their range, and the cubic skips its scaling and normalisation; the same root bit for bit.
 template <class Finder, class CornerKind = AnyCorners>
 inline double first_root(const Finder& finder, const double corner[8], double iso, const std::array<double, 3>& p_in,
                          const std::array<double, 3>& p_out, bool closed_end, RootBracket* later = nullptr,
