@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <type_traits>
 #include <vector>
 
 #include "octiso/octree.h"
@@ -185,8 +184,7 @@ private:
     /// An integer grid's cells get the octree's unscaled cubic too (cell.h, IntegerCorners): the
     /// peer in its best configuration, the same roots.
     bool test_cell(Walk& w, Coord v, const double corner[8], double t_in, double t_out, bool closed_end) const {
-        using CornerKind = std::conditional_t<std::is_integral_v<T>, IntegerCorners, AnyCorners>;
-        return intersect_cell<Finder, false, CornerKind>(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
+        return intersect_cell<Finder, false, CornerKindOf<T>>(finder_, scene_, w, v, corner, t_in, t_out, closed_end);
     }
 
     const MacrocellGrid<T>& grid_;

@@ -117,7 +117,7 @@ public:
     static constexpr bool kDeferRoots = !Recorder::kOn;
     /// Every corner a traversal of an integer file tests is one of its voxels (or, at a coarse
     /// level, a stored scalar of its type), so the cell's cubic skips its scaling (cell.h).
-    using CornerKind = std::conditional_t<std::is_integral_v<T>, IntegerCorners, AnyCorners>;
+    using CornerKind = CornerKindOf<T>;
 
     /// The most rays one trace_packet() call takes (packet_size.h).
     static constexpr int kMaxPacket = kMaxTracePacket;

@@ -602,8 +602,8 @@ TYPED_TEST(RootFinder, IntegerCornersGiveTheSameRootBitForBit) {
         switch (n % 6) {
             case 0: g.p_out = g.p_in; break;                                       // zero length
             case 1: g.p_in[n % 3] = 0, g.p_out[n % 3] = 1; break;                  // face to face
-            case 2: g.p_in[0] = 1e-12, g.p_out[0] = 1e-12 + 1e-27, g.p_out[1] = g.p_in[1]; break;   // the
-                // shortest non-zero move along an axis that snap_to_face leaves (cell_hit.h)
+            // The shortest non-zero move along an axis that snap_to_face leaves (cell_hit.h).
+            case 2: g.p_in[0] = 1e-12, g.p_out[0] = 1e-12 + 1e-27, g.p_out[1] = g.p_in[1]; break;
             case 3: g.p_out[2] = g.p_in[2] * (1 + 1e-15); break;
             default: break;
         }
