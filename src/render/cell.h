@@ -115,10 +115,11 @@ template <typename R> struct CellCubic {
 template <typename R, class CornerKind = AnyCorners>
 inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const std::array<double, 3>& p_in,
                                     const std::array<double, 3>& p_out, CornerKind = {}) {
+    constexpr bool kUnscaled = std::is_same_v<CornerKind, IntegerCorners>;
     // 1. g = (corner - iso) * 2^-e, in [-2, 2] (e = 0 for IntegerCorners: |g| <= 2^33).
     int e = 0;
     R g[8];
-    if constexpr (std::is_same_v<CornerKind, IntegerCorners>) {
+    if constexpr (kUnscaled) {
         for (int i = 0; i < 8; ++i) g[i] = R(corner[i]) - R(iso);
     } else {
         double m = std::fabs(iso);
@@ -147,18 +148,16 @@ inline CellCubic<R> make_cell_cubic(const double corner[8], double iso, const st
     f.c[3] = k7 * dx * dy * dz;
     f.f_out = trilinear<R>(g, R(p_out[0]), R(p_out[1]), R(p_out[2]));
 
-    if constexpr (std::is_same_v<CornerKind, IntegerCorners>) {   // step 3 changes no root
-        f.f_in = f.c[0];
-        f.scale_exp = 0;
-        return f;
-    }
-    // 3. Normalise so the largest magnitude lies in [1/2, 1): exact, signs and zeros preserved.
-    R big = std::fabs(f.f_out);
-    for (int i = 0; i < 4; ++i) big = std::max(big, std::fabs(f.c[i]));
+    // 3. Normalise so the largest magnitude lies in [1/2, 1): exact, signs and zeros preserved
+    //    (e2 = 0 for IntegerCorners: the step changes no root).
     int e2 = 0;
-    if (big > 0) e2 = frexp_exponent(big);
-    for (int i = 0; i < 4; ++i) f.c[i] = scale_by_power_of_two(f.c[i], -e2);
-    f.f_out = scale_by_power_of_two(f.f_out, -e2);
+    if constexpr (!kUnscaled) {
+        R big = std::fabs(f.f_out);
+        for (int i = 0; i < 4; ++i) big = std::max(big, std::fabs(f.c[i]));
+        if (big > 0) e2 = frexp_exponent(big);
+        for (int i = 0; i < 4; ++i) f.c[i] = scale_by_power_of_two(f.c[i], -e2);
+        f.f_out = scale_by_power_of_two(f.f_out, -e2);
+    }
     f.f_in = f.c[0];
     f.scale_exp = e + e2;
     return f;

@@ -478,13 +478,6 @@ TYPED_TEST(RootFinder, E16_SliverThroughAnEdgeReportedByExactlyOneCell) {
     EXPECT_LT(solve<TypeParam>(sliver_miss), 0);
 }
 
-// ---------------------------------------------------------------------------------------------
-/// first_root's early exit (keeps_one_sign: a one-signed Bernstein hull) returns what the walk it
-/// skips returns, bit for bit, for every finder: on uniform random cells, on near-tangent ones (the
-/// isovalue within a few ulps of the value at a stationary point, where a walk's rounding could see
-/// a sign change) and on cells whose hull clears zero by a hair around the exit's margin (the
-/// isovalue just below the smallest or above the largest Bernstein coefficient). The exit must
-/// fire on random and on hull-edge cells (not a vacuous check).
 /// The field's values at the stationary points of segment g inside (0, 1): where an isovalue
 /// makes the segment touch the surface.
 std::vector<double> stationary_values(const Seg& g) {
@@ -500,6 +493,13 @@ std::vector<double> stationary_values(const Seg& g) {
     return values;
 }
 
+// ---------------------------------------------------------------------------------------------
+/// first_root's early exit (keeps_one_sign: a one-signed Bernstein hull) returns what the walk it
+/// skips returns, bit for bit, for every finder: on uniform random cells, on near-tangent ones (the
+/// isovalue within a few ulps of the value at a stationary point, where a walk's rounding could see
+/// a sign change) and on cells whose hull clears zero by a hair around the exit's margin (the
+/// isovalue just below the smallest or above the largest Bernstein coefficient). The exit must
+/// fire on random and on hull-edge cells (not a vacuous check).
 TYPED_TEST(RootFinder, EarlyExitReturnsWhatTheWalkReturns) {
     using R = typename TypeParam::Real;
     std::mt19937_64 rng(19980101);
@@ -552,9 +552,9 @@ TYPED_TEST(RootFinder, EarlyExitReturnsWhatTheWalkReturns) {
 /// What the octree traversal of an integer file vouches for (IntegerCorners, cell.h: voxels of
 /// an integer type, the isovalue inside their range) lets the cubic skip its scaling and its
 /// normalisation; every root and miss must stay the one of the normalised path, bit for bit, and
-/// a pending bracket the same up to that power of two, for all four
-/// integer ranges, isovalues on and between the values, and stiff segments (zero length, on a
-/// face, nearly axis-parallel, near a tangent).
+/// a pending bracket the same up to that power of two, for all four integer ranges, isovalues on
+/// and between the values, and stiff segments (zero length, on a face, nearly axis-parallel, near
+/// a tangent).
 TYPED_TEST(RootFinder, IntegerCornersGiveTheSameRootBitForBit) {
     std::mt19937_64 rng(20261207);
     std::uniform_real_distribution<double> u01(0, 1);
