@@ -5,6 +5,7 @@
 #include "io/png_writer.h"
 
 #include <png.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <csetjmp>
@@ -62,7 +63,13 @@ bool encode(Sink& sink, int width, int height, const uint8_t* rgb, PngEffort eff
     }
     png_set_write_fn(png, &sink, on_write, on_flush);
     png_set_compression_level(png, std::clamp(effort.zlib_level, 0, 9));
-    if (!effort.row_filters) png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
+    if (effort.deflate == PngDeflate::run_length) png_set_compression_strategy(png, Z_RLE);
+    switch (effort.filter) {
+        case PngRowFilter::adaptive: break;   // libpng's default: all five, chosen per row
+        case PngRowFilter::none: png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE); break;
+        case PngRowFilter::paeth: png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_PAETH); break;
+        case PngRowFilter::up: png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP); break;
+    }
     png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);   // CONVENTIONS 2: colour is 8-bit sRGB

@@ -15,19 +15,31 @@ namespace octiso::io {
 /// Whether `path` names a PNG file by its extension (".png", any case).
 bool is_png_path(const std::string& path);
 
-/// How hard the encoder works: zlib's level (0-9) and whether libpng picks a filter per row
-/// (adaptive) or stores the rows unfiltered.
+/// The row filter libpng applies before deflate: its adaptive choice per row (libpng's default,
+/// which tries all five filters on every row), none, or one filter for every row.
+enum class PngRowFilter { adaptive, none, paeth, up };
+/// zlib's strategy: its standard match search at `zlib_level`, or run-length matches only
+/// (Z_RLE: distance-1 matches, the level no longer matters).
+enum class PngDeflate { standard, run_length };
+
+/// How hard the encoder works: zlib's level (0-9) and strategy, and the row filter.
 struct PngEffort {
     int zlib_level;
-    bool row_filters;
+    PngRowFilter filter;
+    PngDeflate deflate = PngDeflate::standard;
 };
-/// Files: libpng's defaults (zlib 6, adaptive row filters); 1.4-2.9 % more bytes than OpenImageIO
-/// 2.4 wrote for the same frames (three renders at 512^2 and 1024^2).
-inline constexpr PngEffort kPngFile{6, true};
+/// Files: every row Paeth-filtered, deflated as runs. On octiso-render's default frames
+/// (`octiso-bench writers`: the MRI templates, plume and mixing at 512^2 and 1024^2) 1.01-1.04 x
+/// the bytes of libpng's defaults (zlib 6, adaptive filters) in 0.16-0.34 x the encode time; zlib 1
+/// with the same filter is as fast and smaller on frames seen whole, but 1.19 x on a close-up that
+/// the surface fills. An orbit or a series encodes its frames on one writer thread beside the
+/// trace, and at libpng's defaults a 1024^2 frame took longer to write than to trace on 2 threads
+/// (BENCHMARKS "Image writers": whole orbits 0.64-0.90 x the wall time).
+inline constexpr PngEffort kPngFile{1, PngRowFilter::paeth, PngDeflate::run_length};
 /// The viewer's frames, which only cross a socket: zlib 1 without row filters, 0.49-0.52 x the
 /// encode time of zlib 1 with them on five rendered frames at 512^2 and 1024^2 for 0.92-1.04 x
 /// the bytes (BENCHMARKS "Start-up: PNG and EXR without the image module").
-inline constexpr PngEffort kPngStream{1, false};
+inline constexpr PngEffort kPngStream{1, PngRowFilter::none};
 
 /// PNG bytes of `width` x `height` RGB pixels (`rgb`, 3 bytes a pixel, row 0 at the top), tagged
 /// sRGB. Throws Error(ErrorKind::Other) naming `what` if libpng fails or the size is not a PNG's,

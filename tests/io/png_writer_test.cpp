@@ -40,7 +40,9 @@ TEST(PngWriter, PixelsReadBackExactlyAtEverySizeAndLevel) {
     const std::pair<int, int> sizes[] = {{1, 1}, {7, 3}, {3, 7}, {257, 129}, {512, 512}};
     uint32_t seed = 1;
     for (const auto& [w, h] : sizes) {
-        for (io::PngEffort effort : {io::kPngFile, io::kPngStream, io::PngEffort{0, true}, io::PngEffort{9, false}}) {
+        for (io::PngEffort effort :
+             {io::kPngFile, io::kPngStream, io::PngEffort{0, io::PngRowFilter::adaptive}, io::PngEffort{9, io::PngRowFilter::none},
+              io::PngEffort{6, io::PngRowFilter::up, io::PngDeflate::run_length}, io::PngEffort{6, io::PngRowFilter::adaptive}}) {
             const Frame f = random_frame(w, h, seed++);
             const std::vector<unsigned char> bytes = io::encode_rgb8_png(w, h, f.rgb.data(), effort, "test");
             const std::string path = dir.file("f.png");
@@ -50,7 +52,8 @@ TEST(PngWriter, PixelsReadBackExactlyAtEverySizeAndLevel) {
             ASSERT_EQ(rw, w);
             ASSERT_EQ(rh, h);
             ASSERT_EQ(rc, 3);
-            EXPECT_EQ(back, f.rgb) << w << "x" << h << " at level " << effort.zlib_level << (effort.row_filters ? " filtered" : "");
+            EXPECT_EQ(back, f.rgb) << w << "x" << h << " at level " << effort.zlib_level << ", filter " << int(effort.filter)
+                                << ", deflate " << int(effort.deflate);
         }
     }
 }
