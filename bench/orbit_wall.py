@@ -8,7 +8,10 @@ the bytes of the PNG files. The writer thread encodes frame k while frame k+1 is
 times; each PNG of B must decode to the pixels of A's (exit 1 otherwise).
 
     bench/orbit_wall.py --a OLD/octiso-render [--b build/octiso-render] [--rounds 5] [--orbit 8]
-                        [--results DIR] FILE.oct@ISO:SIZE[:ZOOM[:THREADS]] ...
+                        [--aovs] [--results DIR] FILE.oct@ISO:SIZE[:ZOOM[:THREADS]] ...
+
+--aovs also writes each frame's depth and normal as OpenEXR (`--depth d_%d.exr --normal n_%d.exr`);
+their floats must be the same too (idiff -fail 0) and their bytes are counted with the PNGs'.
 
 --results DIR writes orbit_wall.json there (default: a temporary folder, printed). Used for
 BENCHMARKS.md, "Image writers"."""
@@ -33,12 +36,21 @@ def decoded(path):
             return f.read()
 
 
+def outputs(args):
+    """The files one orbit writes."""
+    names = [f"f_{i}.png" for i in range(args.orbit)]
+    if args.aovs:
+        names += [f"{kind}_{i}.exr" for kind in ("d", "n") for i in range(args.orbit)]
+    return names
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--a", required=True)
     ap.add_argument("--b", default="build/octiso-render")
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--orbit", type=int, default=8)
+    ap.add_argument("--aovs", action="store_true")
     ap.add_argument("--results")
     ap.add_argument("cases", nargs="+")
     args = ap.parse_args()
@@ -61,6 +73,8 @@ def main():
                 os.makedirs(out, exist_ok=True)
                 cmd = [binary, c["file"], "--iso", c["iso"], "--size", f"{c['size']}x{c['size']}", "--zoom", c["zoom"],
                        "--threads", c["threads"], "--orbit", str(args.orbit), "-o", os.path.join(out, "f_%d.png"), "--json"]
+                if args.aovs:
+                    cmd += ["--depth", os.path.join(out, "d_%d.exr"), "--normal", os.path.join(out, "n_%d.exr")]
                 t0 = time.perf_counter()
                 report = json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout)
                 wall = time.perf_counter() - t0
@@ -68,11 +82,15 @@ def main():
                     "wall": wall,
                     "write": sum(f["phases"]["write"] for f in report["frames"]),
                     "trace": sum(f["phases"]["trace"] for f in report["frames"]),
-                    "bytes": sum(os.path.getsize(os.path.join(out, f"f_{i}.png")) for i in range(args.orbit))})
+                    "bytes": sum(os.path.getsize(os.path.join(out, name)) for name in outputs(args))})
             if r == 0:
-                for i in range(args.orbit):
-                    name = f"f_{i}.png"
-                    if decoded(os.path.join(work, "a", name)) != decoded(os.path.join(work, "b", name)):
+                for name in outputs(args):
+                    a_file, b_file = os.path.join(work, "a", name), os.path.join(work, "b", name)
+                    if name.endswith(".exr"):
+                        equal = subprocess.run(["idiff", "-fail", "0", "-warn", "0", a_file, b_file], capture_output=True).returncode == 0
+                    else:
+                        equal = decoded(a_file) == decoded(b_file)
+                    if not equal:
                         same[c["name"]] = False
     rows = []
     print(f"{'case':<40} {'A wall s':>15} {'B wall s':>15} {'B/A min':>8} {'B/A med':>8} {'write A->B s':>14} "
@@ -95,7 +113,7 @@ def main():
     os.makedirs(results, exist_ok=True)
     path = os.path.join(results, "orbit_wall.json")
     with open(path, "w") as f:
-        json.dump({"a": args.a, "b": args.b, "rounds": args.rounds, "orbit": args.orbit, "rows": rows}, f, indent=1)
+        json.dump({"a": args.a, "b": args.b, "rounds": args.rounds, "orbit": args.orbit, "aovs": args.aovs, "rows": rows}, f, indent=1)
     print("wrote", path)
     return 0 if all(same.values()) else 1
 

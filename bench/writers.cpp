@@ -4,21 +4,28 @@
 // render pays it in its wall time. Each setting encodes the same rendered frames, interleaved
 // round by round (a load spike hits every setting alike); every PNG is decoded again and must give
 // the frame's pixels; times and bytes are given against libpng's defaults (zlib 6, adaptive row
-// filters), the file setting before this benchmark.
+// filters), the file setting before this benchmark. The depth and normal AOVs (OpenEXR, ZIP) are
+// timed the same way at OpenEXR's zlib level 4 (before), at kExrZipLevel, and compressed by every
+// hardware thread; each file must read back to the same float bits.
 #include <png.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <thread>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "bench/bench.h"
 #include "bench/dataset_spec.h"
+#include "io/exr_writer.h"
 #include "io/png_writer.h"
 #include "octiso/any_octree.h"
 #include "octiso/camera.h"
 #include "octiso/error.h"
+#include "octiso/image.h"
 #include "octiso/reader.h"
 #include "octiso/render.h"
 #include "octiso/shading.h"
@@ -98,6 +105,25 @@ std::vector<uint8_t> decode_rgb(const std::vector<unsigned char>& bytes) {
     return rgb;
 }
 
+struct ExrSetting {
+    std::string name;
+    int zip_level, threads;
+};
+
+std::vector<ExrSetting> exr_settings() {
+    return {{"zip 4, 1 thread (OpenEXR's level)", 4, 1},
+            {"zip " + std::to_string(io::kExrZipLevel) + ", 1 thread (kExrZipLevel)", io::kExrZipLevel, 1},
+            {"zip " + std::to_string(io::kExrZipLevel) + ", all threads", io::kExrZipLevel, 0}};
+}
+
+/// Whether EXR bytes read back (through the image module, from a scratch file) to `pixels` bit for bit.
+bool exr_reads_back(const std::vector<unsigned char>& bytes, const std::vector<float>& pixels, const std::string& scratch) {
+    std::ofstream(scratch, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    const FloatImage back = read_image(scratch);
+    std::remove(scratch.c_str());
+    return back.pixels.size() == pixels.size() && std::memcmp(back.pixels.data(), pixels.data(), pixels.size() * sizeof(float)) == 0;
+}
+
 struct Cell {
     std::vector<double> ms;
     size_t bytes = 0;
@@ -160,6 +186,29 @@ int run_writers(cli::Args& args) {
         }
     }
 
+    // The AOVs: depth (one channel) and normal (three) of every frame, as octiso-render writes them.
+    const std::vector<ExrSetting> exr_candidates = exr_settings();
+    const std::string scratch = results + "/writers_scratch.exr";
+    std::vector<std::vector<Cell>> exr_cells(2 * frames.size(), std::vector<Cell>(exr_candidates.size()));
+    for (int round = 0; round < rounds; ++round) {
+        for (size_t fi = 0; fi < frames.size(); ++fi) {
+            const Frame& f = frames[fi];
+            for (int aov = 0; aov < 2; ++aov) {
+                const std::vector<float>& pixels = aov == 0 ? f.depth : f.normal;
+                const std::vector<std::string> names = aov == 0 ? std::vector<std::string>{"Z"} : std::vector<std::string>{"R", "G", "B"};
+                for (size_t si = 0; si < exr_candidates.size(); ++si) {
+                    const auto t0 = std::chrono::steady_clock::now();
+                    const std::vector<unsigned char> bytes = io::encode_float_exr(f.width, f.height, pixels.data(), names, "aov",
+                                                                                   exr_candidates[si].threads, exr_candidates[si].zip_level);
+                    Cell& c = exr_cells[2 * fi + size_t(aov)][si];
+                    c.ms.push_back(seconds_since(t0) * 1e3);
+                    c.bytes = bytes.size();
+                    if (round == 0 && !exr_reads_back(bytes, pixels, scratch)) c.same_pixels = false;
+                }
+            }
+        }
+    }
+
     Table table({"frame", "setting", "encode ms (min)", "median", "bytes", "time / defaults", "bytes / defaults", "pixels"});
     bool all_same = true;
     for (size_t fi = 0; fi < frames.size(); ++fi) {
@@ -172,11 +221,31 @@ int run_writers(cli::Args& args) {
                        fmt(c.ms[0] / ref.ms[0], 3), fmt(double(c.bytes) / double(ref.bytes), 3), c.same_pixels ? "same" : "DIFFER"});
         }
     }
+    Table exr_table({"frame", "AOV", "setting", "encode ms (min)", "median", "bytes", "time / level 4", "bytes / level 4", "floats"});
+    for (size_t fi = 0; fi < frames.size(); ++fi) {
+        for (int aov = 0; aov < 2; ++aov) {
+            std::vector<Cell>& row = exr_cells[2 * fi + size_t(aov)];
+            for (Cell& c : row) std::sort(c.ms.begin(), c.ms.end());
+            for (size_t si = 0; si < exr_candidates.size(); ++si) {
+                const Cell& c = row[si];
+                all_same = all_same && c.same_pixels;
+                exr_table.add({specs[fi].label, aov == 0 ? "depth" : "normal", exr_candidates[si].name, fmt(c.ms[0], 2),
+                               fmt(c.ms[c.ms.size() / 2], 2), std::to_string(c.bytes), fmt(c.ms[0] / row[0].ms[0], 3),
+                               fmt(double(c.bytes) / double(row[0].bytes), 3), c.same_pixels ? "same" : "DIFFER"});
+            }
+        }
+    }
     std::cout << "PNG encode of rendered frames, " << rounds << " interleaved rounds, 1 thread (" << machine_description() << ")\n";
     if (markdown)
         table.print_markdown(std::cout);
     else
         table.print(std::cout);
+    std::cout << "\nOpenEXR encode of their depth and normal AOVs (ZIP), " << std::thread::hardware_concurrency()
+              << " hardware threads\n";
+    if (markdown)
+        exr_table.print_markdown(std::cout);
+    else
+        exr_table.print(std::cout);
     const std::string path = write_json(results, "writers", [&](cli::JsonWriter& j) {
         j.begin_object();
         j.field("rounds", int64_t(rounds)).field("machine", machine_description()).field("all_pixels_same", all_same);
@@ -196,17 +265,34 @@ int run_writers(cli::Args& args) {
             }
         }
         j.end_array();
+        j.key("exr_rows").begin_array();
+        for (size_t fi = 0; fi < frames.size(); ++fi) {
+            for (int aov = 0; aov < 2; ++aov) {
+                const std::vector<Cell>& row = exr_cells[2 * fi + size_t(aov)];
+                for (size_t si = 0; si < exr_candidates.size(); ++si) {
+                    const Cell& c = row[si];
+                    j.begin_object().field("frame", specs[fi].label).field("aov", std::string(aov == 0 ? "depth" : "normal"));
+                    j.field("setting", exr_candidates[si].name).field("zip_level", int64_t(exr_candidates[si].zip_level));
+                    j.field("threads", int64_t(exr_candidates[si].threads)).field("min_ms", c.ms[0]);
+                    j.field("median_ms", c.ms[c.ms.size() / 2]).field("bytes", int64_t(c.bytes));
+                    j.field("time_vs_level4", c.ms[0] / row[0].ms[0]).field("bytes_vs_level4", double(c.bytes) / double(row[0].bytes));
+                    j.field("same_floats", c.same_pixels).end_object();
+                }
+            }
+        }
+        j.end_array();
+        j.field("hardware_threads", int64_t(std::thread::hardware_concurrency()));
         j.end_object();
     });
     std::cout << "wrote " << path << "\n";
     if (!all_same) {
-        std::cerr << "octiso-bench writers: a PNG did not decode to its frame's pixels\n";
+        std::cerr << "octiso-bench writers: an image did not read back to its frame's pixels\n";
         return 1;
     }
     return 0;
 }
 
-const bool kRegistered = register_bench("writers", "PNG encode time and bytes of rendered frames per encoder setting", &run_writers);
+const bool kRegistered = register_bench("writers", "PNG and OpenEXR encode time and bytes of rendered frames per setting", &run_writers);
 
 }  // namespace
 }  // namespace octiso::bench

@@ -18,9 +18,11 @@ namespace octiso {
 /// Writes frame.rgb. Throws Error(path, ...) if the format is unknown or the write fails.
 void write_colour_image(const std::string& path, const Frame& frame);
 /// Writes frame.depth as channel "Z" (+inf on a miss where the format allows, else a large value).
-void write_depth_image(const std::string& path, const Frame& frame);
-/// Writes frame.normal as float R,G,B.
-void write_normal_image(const std::string& path, const Frame& frame);
+/// `threads` compress an OpenEXR file's blocks (1: the calling thread; 0: every hardware thread;
+/// the same bytes on any count); other formats ignore it.
+void write_depth_image(const std::string& path, const Frame& frame, int threads = 1);
+/// Writes frame.normal as float R,G,B (`threads` as write_depth_image).
+void write_normal_image(const std::string& path, const Frame& frame, int threads = 1);
 
 /// What an image file will hold: the 8-bit colour (write_colour_image) or an AOV (depth, normal:
 /// floats, or mapped to 8 bits by OpenImageIO where the format holds no floats).

@@ -6,12 +6,14 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfThreading.h>
 
 #include <algorithm>
 #include <cstring>
 #include <exception>
 #include <limits>
 #include <new>
+#include <thread>
 
 #include "io/file_extension.h"
 #include "octiso/error.h"
@@ -39,12 +41,25 @@ private:
     size_t position_ = 0;
 };
 
+/// How many of OpenEXR's workers a file may keep busy (0: none, the calling thread compresses).
+/// Its pool is process-wide; it is sized once, to the hardware threads, and never resized, so that
+/// no file being written by another thread sees the pool change under it.
+int worker_threads(int wanted) {
+    if (wanted == 1) return 0;
+    static const int pool = [] {
+        const int n = int(std::max(1u, std::thread::hardware_concurrency()));
+        Imf::setGlobalThreadCount(n);
+        return n;
+    }();
+    return wanted <= 0 ? pool : std::min(wanted, pool);
+}
+
 }  // namespace
 
 bool is_exr_path(const std::string& path) { return has_extension(path, ".exr"); }
 
 std::vector<unsigned char> encode_float_exr(int width, int height, const float* pixels, const std::vector<std::string>& names,
-                                            const std::string& what) {
+                                            const std::string& what, int threads, int zip_level) {
     const size_t channels = names.size();
     // Byte strides are size_t; the pixel count of a row must also fit OpenEXR's int arithmetic.
     if (width <= 0 || height <= 0 || channels == 0 || channels > 4 ||
@@ -55,6 +70,7 @@ std::vector<unsigned char> encode_float_exr(int width, int height, const float* 
     try {
         Imf::Header header(width, height);
         header.compression() = Imf::ZIP_COMPRESSION;
+        header.zipCompressionLevel() = std::clamp(zip_level, 1, 9);   // not written to the file
         Imf::FrameBuffer frame;
         const size_t x_stride = channels * sizeof(float), y_stride = x_stride * size_t(width);
         for (size_t c = 0; c < channels; ++c) {
@@ -64,7 +80,7 @@ std::vector<unsigned char> encode_float_exr(int width, int height, const float* 
             frame.insert(names[c], Imf::Slice(Imf::FLOAT, base, x_stride, y_stride));
         }
         MemoryStream stream(bytes);
-        Imf::OutputFile file(stream, header, 0);   // 0: no OpenEXR worker threads of its own
+        Imf::OutputFile file(stream, header, worker_threads(threads));   // 0: the calling thread alone
         file.setFrameBuffer(frame);
         file.writePixels(height);
     } catch (const std::bad_alloc&) {

@@ -21,7 +21,7 @@ namespace {
 using image_codec::Pixel;
 
 void write_image(const std::string& path, int width, int height, int channels, Pixel type, const void* pixels,
-                 const std::vector<std::string>& names, Pixel file_type) {
+                 const std::vector<std::string>& names, Pixel file_type, int exr_threads = 1) {
     // Encode into memory, then write the bytes ourselves with every write checked: OIIO's PNG
     // writer did not report ENOSPC, and a truncated PNG was renamed into place (issue 18).
     // Colour PNG (libpng) and float OpenEXR (OpenEXR) without the module; check_image_path
@@ -33,7 +33,7 @@ void write_image(const std::string& path, int width, int height, int channels, P
     }
     if (type == Pixel::f32 && file_type == Pixel::f32 && io::is_exr_path(path)) {
         OCTISO_CHECK(names.size() == size_t(channels), "one name per channel");
-        const auto bytes = io::encode_float_exr(width, height, static_cast<const float*>(pixels), names, path);
+        const auto bytes = io::encode_float_exr(width, height, static_cast<const float*>(pixels), names, path, exr_threads);
         write_file_atomically(path, bytes.data(), bytes.size());
         return;
     }
@@ -83,13 +83,13 @@ void write_colour_image(const std::string& path, const Frame& frame) {
     write_image(path, frame.width, frame.height, 3, Pixel::u8, frame.rgb.data(), {"R", "G", "B"}, Pixel::u8);
 }
 
-void write_depth_image(const std::string& path, const Frame& frame) {
+void write_depth_image(const std::string& path, const Frame& frame, int threads) {
     if (frame.depth.empty()) throw Error(path, "the frame has no depth image", ErrorKind::Other);
     if (frame.depth.size() != size_t(frame.width) * size_t(frame.height))
         throw Error(path, "the depth image is not width x height floats", ErrorKind::Other);
     const Pixel type = float_or_native(path);
     if (type == Pixel::f32) {
-        write_image(path, frame.width, frame.height, 1, Pixel::f32, frame.depth.data(), {"Z"}, type);
+        write_image(path, frame.width, frame.height, 1, Pixel::f32, frame.depth.data(), {"Z"}, type, threads);
         return;
     }
     // An 8-bit format cannot hold distances: scale the hit range to [1/255, 1], misses 0.
@@ -102,13 +102,13 @@ void write_depth_image(const std::string& path, const Frame& frame) {
     write_image(path, frame.width, frame.height, 1, Pixel::f32, scaled.data(), {"Z"}, type);
 }
 
-void write_normal_image(const std::string& path, const Frame& frame) {
+void write_normal_image(const std::string& path, const Frame& frame, int threads) {
     if (frame.normal.empty()) throw Error(path, "the frame has no normal image", ErrorKind::Other);
     if (frame.normal.size() != size_t(frame.width) * size_t(frame.height) * 3)
         throw Error(path, "the normal image is not width x height x 3 floats", ErrorKind::Other);
     const Pixel type = float_or_native(path);
     if (type == Pixel::f32) {
-        write_image(path, frame.width, frame.height, 3, Pixel::f32, frame.normal.data(), {"R", "G", "B"}, type);
+        write_image(path, frame.width, frame.height, 3, Pixel::f32, frame.normal.data(), {"R", "G", "B"}, type, threads);
         return;
     }
     std::vector<float> mapped(frame.normal.size());   // 8-bit: the usual n * 0.5 + 0.5 encoding

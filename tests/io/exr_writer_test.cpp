@@ -63,6 +63,23 @@ TEST(ExrWriter, TheSameImageGivesTheSameBytes) {
     EXPECT_EQ(io::encode_float_exr(64, 48, pixels.data(), {"Z"}, "a"), io::encode_float_exr(64, 48, pixels.data(), {"Z"}, "b"));
 }
 
+TEST(ExrWriter, WorkerThreadsGiveTheSameBytesAndEveryLevelReadsBack) {
+    ScratchDir dir{"octiso_exr_writer"};
+    // 203 rows: 13 ZIP blocks of 16 rows, the last one short, so several workers share the file.
+    const int w = 71, h = 203;
+    const std::vector<float> normal = random_floats(size_t(w) * h * 3, 11, false);
+    const std::vector<std::string> names{"R", "G", "B"};
+    const std::vector<unsigned char> alone = io::encode_float_exr(w, h, normal.data(), names, "n", 1);
+    for (int threads : {0, 2, 3, 64}) EXPECT_EQ(io::encode_float_exr(w, h, normal.data(), names, "n", threads), alone) << threads;
+    for (int level : {1, 4, 9}) {
+        const std::vector<unsigned char> bytes = io::encode_float_exr(w, h, normal.data(), names, "n", 2, level);
+        const std::string path = dir.file("level.exr");
+        std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        const FloatImage back = read_image(path);
+        EXPECT_TRUE(same_bits(back.pixels, normal)) << "zip level " << level;
+    }
+}
+
 TEST(ExrWriter, DepthAndNormalWritersTakeEverySpellingOfExr) {
     ScratchDir dir{"octiso_exr_writer"};
     Frame f;
