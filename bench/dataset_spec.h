@@ -9,6 +9,9 @@
 
 #include "cli/common/cli.h"
 #include "octiso/error.h"
+#include "octiso/loaded_volume.h"
+#include "octiso/reader.h"
+#include "octiso/synthetic.h"
 
 namespace octiso::bench {
 
@@ -38,6 +41,18 @@ inline std::vector<DatasetSpec> parse_dataset_specs(const std::string& text, con
         pos = comma + 1;
     }
     return out;
+}
+
+/// The dense volume of a spec (a synthetic field at N^3, N up to `max_side`, or the scan read
+/// whole); empty for a .oct file, which is used as it is.
+inline LoadedVolume open_dense(const DatasetSpec& s, uint32_t max_side = 4096) {
+    if (s.is_oct) return {};
+    if (s.is_synthetic) {
+        const size_t colon = s.name.find(':');
+        const uint32_t n = uint32_t(cli::parse_int(s.name.substr(colon + 1), "--dataset", 4, max_side));
+        return synthetic_step(s.name.substr(0, colon), Dims{n, n, n}, 0);
+    }
+    return open_volume(s.source, RawOptions{});
 }
 
 }  // namespace octiso::bench

@@ -64,17 +64,6 @@ const char* const kLodUsage =
     "  --cold N: also N rounds of a first frame from a cold page cache (whole view, octiso-render)\n"
     "  --quick: plume:64@40.5, 128x128, factors 1,4, 1 round, --rules at units 2; --tag T: write lod_T.json";
 
-/// The dense volume of a scan or synthetic (for --rules); empty for a .oct given as it is.
-LoadedVolume dense_of(const DatasetSpec& s) {
-    if (s.is_oct) return {};
-    if (s.is_synthetic) {
-        const size_t colon = s.name.find(':');
-        const uint32_t n = uint32_t(cli::parse_int(s.name.substr(colon + 1), "--dataset", 4, 4096));
-        return synthetic_step(s.name.substr(0, colon), Dims{n, n, n}, 0);
-    }
-    return open_volume(s.source, RawOptions{});
-}
-
 struct FrameError {
     uint64_t exact_hits = 0, mismatched = 0;
     /// Cracks: pixels the exact frame hits and this one misses while this one hits both
@@ -364,7 +353,7 @@ int run_lod(cli::Args& args) {
                 }
             }
         if (rules) {
-            const LoadedVolume dense = dense_of(spec);
+            const LoadedVolume dense = open_dense(spec);
             if (dense.empty()) continue;
             const std::vector<uint32_t> units = quick ? std::vector<uint32_t>{2} : std::vector<uint32_t>{2, 4, 8};
             const Camera camera = frame_data_box(info.dims, info.placement, images.front(), images.front());

@@ -44,16 +44,6 @@ const char* const kPacketsUsage =
     "  default: ch2, ch2bet, ch2better at 100.5 and 25.5, aal.nii.gz@0.5, plume:256@40.5, mixing:256@127.5;\n"
     "  --quick: plume:48@40.5, 128x128, 1 thread, 2 repeats";
 
-LoadedVolume open_spec(const DatasetSpec& s) {
-    const size_t colon = s.name.find(':');
-    if (colon != std::string::npos) {
-        const std::string kind = s.name.substr(0, colon);
-        const uint32_t n = uint32_t(cli::parse_int(s.name.substr(colon + 1), "--dataset", 4, 2048));
-        return synthetic_step(kind, Dims{n, n, n}, 0);
-    }
-    return open_volume(s.source, RawOptions{});
-}
-
 struct Method {
     std::string name;
     std::function<double(Frame*)> render;   ///< one frame; returns seconds (CPU at 1 thread)
@@ -162,7 +152,7 @@ int run_packets(cli::Args& args) {
     std::map<std::string, bool> incoherent_done;
     bool all_identical = true;
     for (const DatasetSpec& spec : specs) {
-        const LoadedVolume volume = open_spec(spec);
+        const LoadedVolume volume = open_dense(spec, 2048);
         const AnyOctree tree = AnyOctree::build(volume, BuildOptions{});
         std::cerr << "== " << spec.name << " iso " << spec.iso << "\n";
         std::optional<MeshPeerResult> mesh;

@@ -56,6 +56,7 @@ FrameSpec parse_frame_spec(const std::string& item, const std::string& mri_dir) 
         throw Error("--frames", "expected DATA@ISO/SIDE[/ZOOM], found '" + item + "'");
     FrameSpec f;
     f.data = parse_dataset_specs(item.substr(0, slash), mri_dir).at(0);
+    if (f.data.is_oct) throw Error("--frames", "'" + item + "': give the scan or NAME:N, not a .oct file");
     const std::string rest = item.substr(slash + 1);
     const size_t zoom_slash = rest.find('/');
     f.side = int(cli::parse_int(rest.substr(0, zoom_slash), "--frames", 8, 8192));
@@ -63,15 +64,6 @@ FrameSpec parse_frame_spec(const std::string& item, const std::string& mri_dir) 
     if (!(f.zoom > 0)) throw Error("--frames", "the zoom must be > 0 in '" + item + "'");
     f.label = item;
     return f;
-}
-
-LoadedVolume open_frame_data(const DatasetSpec& s) {
-    const size_t colon = s.name.find(':');
-    if (s.is_synthetic && colon != std::string::npos) {
-        const uint32_t n = uint32_t(cli::parse_int(s.name.substr(colon + 1), "--frames", 4, 2048));
-        return synthetic_step(s.name.substr(0, colon), Dims{n, n, n}, 0);
-    }
-    return open_volume(s.source, RawOptions{});
 }
 
 struct Setting {
@@ -157,7 +149,7 @@ int run_writers(cli::Args& args) {
 
     std::vector<Frame> frames;
     for (const FrameSpec& s : specs) {
-        const LoadedVolume volume = open_frame_data(s.data);
+        const LoadedVolume volume = open_dense(s.data, 2048);
         const AnyOctree tree = AnyOctree::build(volume, BuildOptions{});
         RenderOptions o;   // octiso-render's default frame: traced, then shaded by the light kit
         o.isovalues = {s.data.iso};
