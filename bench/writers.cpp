@@ -69,16 +69,20 @@ FrameSpec parse_frame_spec(const std::string& item, const std::string& mri_dir) 
 struct Setting {
     std::string name;
     io::PngEffort effort;
+    int threads = 1;
 };
 
 /// The candidates: libpng's defaults first (the reference of the ratios), the file and stream
-/// settings of png_writer.h, and their neighbours.
+/// settings of png_writer.h, and their neighbours; single-filter settings are encoded in strips
+/// (png_writer.cpp) unless they say libpng's rows; threads 0 is every hardware thread.
 std::vector<Setting> settings() {
     using io::PngDeflate, io::PngRowFilter;
     return {{"zlib 6, adaptive (libpng defaults)", {6, PngRowFilter::adaptive}},
             {"zlib 1, adaptive", {1, PngRowFilter::adaptive}},
             {"runs, adaptive", {1, PngRowFilter::adaptive, PngDeflate::run_length}},
-            {"runs, paeth (kPngFile)", io::kPngFile},
+            {"runs, paeth, libpng's rows", {1, PngRowFilter::paeth, PngDeflate::run_length, true}},
+            {"runs, paeth (kPngFile), strips", io::kPngFile},
+            {"runs, paeth (kPngFile), strips, all threads", io::kPngFile, 0},
             {"zlib 1, paeth", {1, PngRowFilter::paeth}},
             {"zlib 6, paeth", {6, PngRowFilter::paeth}},
             {"runs, up", {1, PngRowFilter::up, PngDeflate::run_length}},
@@ -170,7 +174,8 @@ int run_writers(cli::Args& args) {
             const Frame& f = frames[fi];
             for (size_t si = 0; si < candidates.size(); ++si) {
                 const auto t0 = std::chrono::steady_clock::now();
-                const std::vector<unsigned char> bytes = io::encode_rgb8_png(f.width, f.height, f.rgb.data(), candidates[si].effort, "frame");
+                const std::vector<unsigned char> bytes = io::encode_rgb8_png(f.width, f.height, f.rgb.data(), candidates[si].effort, "frame",
+                                                                                       candidates[si].threads);
                 cells[fi][si].ms.push_back(seconds_since(t0) * 1e3);
                 cells[fi][si].bytes = bytes.size();
                 if (round == 0 && decode_rgb(bytes) != f.rgb) cells[fi][si].same_pixels = false;
@@ -250,6 +255,7 @@ int run_writers(cli::Args& args) {
                 j.begin_object().field("frame", specs[fi].label).field("width", int64_t(frames[fi].width));
                 j.field("setting", candidates[si].name).field("zlib_level", int64_t(e.zlib_level));
                 j.field("filter", int64_t(e.filter)).field("run_length", e.deflate == io::PngDeflate::run_length);
+                j.field("libpng_rows", e.libpng_rows || e.filter == io::PngRowFilter::adaptive).field("threads", int64_t(candidates[si].threads));
                 j.field("min_ms", c.ms[0]).field("median_ms", c.ms[c.ms.size() / 2]).field("bytes", int64_t(c.bytes));
                 j.field("time_vs_defaults", c.ms[0] / cells[fi][0].ms[0]);
                 j.field("bytes_vs_defaults", double(c.bytes) / double(cells[fi][0].bytes)).field("same_pixels", c.same_pixels);

@@ -16,7 +16,9 @@
 namespace octiso {
 
 /// Writes frame.rgb. Throws Error(path, ...) if the format is unknown or the write fails.
-void write_colour_image(const std::string& path, const Frame& frame);
+/// `threads` encode a PNG's strips of rows (1: the calling thread; 0: every core; the same bytes
+/// on any count); other formats ignore it.
+void write_colour_image(const std::string& path, const Frame& frame, int threads = 1);
 /// Writes frame.depth as channel "Z" (+inf on a miss where the format allows, else a large value).
 /// `threads` compress an OpenEXR file's blocks (1: the calling thread; 0: every hardware thread;
 /// the same bytes on any count); other formats ignore it.

@@ -428,9 +428,9 @@ int run(std::vector<std::string>& argv, cli::Ranks& ranks) {
         if (root || !split_frames) {
             const long long index = job.index;
             const auto write = [&, index](const Frame& f) {
-                if (out_path) write_colour_image(name_for(out_path, "-o", index), f);
-                // The AOVs' OpenEXR blocks compressed by as many threads as the trace has (the
-                // writer runs beside the next frame: BENCHMARKS "Image writers").
+                // Each file's PNG strips or OpenEXR blocks compressed by as many threads as the
+                // trace has (the writer runs beside the next frame: BENCHMARKS "Image writers").
+                if (out_path) write_colour_image(name_for(out_path, "-o", index), f, options.threads);
                 if (depth_path) write_depth_image(name_for(depth_path, "--depth", index), f, options.threads);
                 if (normal_path) write_normal_image(name_for(normal_path, "--normal", index), f, options.threads);
             };

@@ -16,7 +16,7 @@ namespace octiso::io {
 bool is_exr_path(const std::string& path);
 
 /// zlib's level in the ZIP blocks (16 rows each): 1, where OpenEXR's default is 4. On the depth
-/// and normal AOVs of rendered frames 0.69-0.91 x the encode time for 1.01-1.05 x the bytes
+/// and normal AOVs of rendered frames 0.74-0.90 x the encode time for 1.01-1.05 x the bytes
 /// (`octiso-bench writers`, BENCHMARKS "Image writers").
 inline constexpr int kExrZipLevel = 1;
 

@@ -21,19 +21,19 @@ namespace {
 using image_codec::Pixel;
 
 void write_image(const std::string& path, int width, int height, int channels, Pixel type, const void* pixels,
-                 const std::vector<std::string>& names, Pixel file_type, int exr_threads = 1) {
+                 const std::vector<std::string>& names, Pixel file_type, int threads = 1) {
     // Encode into memory, then write the bytes ourselves with every write checked: OIIO's PNG
     // writer did not report ENOSPC, and a truncated PNG was renamed into place (issue 18).
     // Colour PNG (libpng) and float OpenEXR (OpenEXR) without the module; check_image_path
     // decides by the same rule.
     if (type == Pixel::u8 && file_type == Pixel::u8 && channels == 3 && io::is_png_path(path)) {
-        const auto bytes = io::encode_rgb8_png(width, height, static_cast<const uint8_t*>(pixels), io::kPngFile, path);
+        const auto bytes = io::encode_rgb8_png(width, height, static_cast<const uint8_t*>(pixels), io::kPngFile, path, threads);
         write_file_atomically(path, bytes.data(), bytes.size());
         return;
     }
     if (type == Pixel::f32 && file_type == Pixel::f32 && io::is_exr_path(path)) {
         OCTISO_CHECK(names.size() == size_t(channels), "one name per channel");
-        const auto bytes = io::encode_float_exr(width, height, static_cast<const float*>(pixels), names, path, exr_threads);
+        const auto bytes = io::encode_float_exr(width, height, static_cast<const float*>(pixels), names, path, threads);
         write_file_atomically(path, bytes.data(), bytes.size());
         return;
     }
@@ -76,11 +76,11 @@ void check_image_path(const std::string& path, const std::string& flag, ImageCon
 
 bool image_format_holds_floats(const std::string& path) { return float_or_native(path) == Pixel::f32; }
 
-void write_colour_image(const std::string& path, const Frame& frame) {
+void write_colour_image(const std::string& path, const Frame& frame, int threads) {
     if (frame.rgb.empty()) throw Error(path, "the frame has no colour image", ErrorKind::Other);
     if (frame.rgb.size() != size_t(frame.width) * size_t(frame.height) * 3)
         throw Error(path, "the colour image is not width x height x 3 bytes", ErrorKind::Other);
-    write_image(path, frame.width, frame.height, 3, Pixel::u8, frame.rgb.data(), {"R", "G", "B"}, Pixel::u8);
+    write_image(path, frame.width, frame.height, 3, Pixel::u8, frame.rgb.data(), {"R", "G", "B"}, Pixel::u8, threads);
 }
 
 void write_depth_image(const std::string& path, const Frame& frame, int threads) {

@@ -27,14 +27,18 @@ struct PngEffort {
     int zlib_level;
     PngRowFilter filter;
     PngDeflate deflate = PngDeflate::standard;
+    /// Expert, for the benchmark's A/B: libpng filters and compresses every row on the calling
+    /// thread even where one filter would let strips of rows go to threads.
+    bool libpng_rows = false;
 };
 /// Files: every row Paeth-filtered, deflated as runs. On octiso-render's default frames
-/// (`octiso-bench writers`: the MRI templates, plume and mixing at 512^2 and 1024^2) 1.01-1.04 x
-/// the bytes of libpng's defaults (zlib 6, adaptive filters) in 0.16-0.34 x the encode time; zlib 1
-/// with the same filter is as fast and smaller on frames seen whole, but 1.19 x on a close-up that
-/// the surface fills. An orbit or a series encodes its frames on one writer thread beside the
-/// trace, and at libpng's defaults a 1024^2 frame took longer to write than to trace on 2 threads
-/// (BENCHMARKS "Image writers": whole orbits 0.64-0.90 x the wall time).
+/// (`octiso-bench writers`: the MRI templates, plume and mixing at 512^2 and 1024^2) 1.00-1.03 x
+/// the bytes of libpng's defaults (zlib 6, adaptive filters) in 0.14-0.28 x the encode time on one
+/// thread (in strips; 0.16-0.34 x through libpng's rows), 0.08-0.17 x on two; zlib 1 with the same
+/// filter is as fast and smaller on frames seen whole, but 1.19 x on a close-up that the surface
+/// fills. An orbit or a series encodes its frames on one writer thread beside the trace, and at
+/// libpng's defaults a 1024^2 frame took longer to write than to trace on 2 threads (BENCHMARKS
+/// "Image writers": whole orbits 0.64-0.90 x the wall time).
 inline constexpr PngEffort kPngFile{1, PngRowFilter::paeth, PngDeflate::run_length};
 /// The viewer's frames, which only cross a socket: zlib 1 without row filters, 0.49-0.52 x the
 /// encode time of zlib 1 with them on five rendered frames at 512^2 and 1024^2 for 0.92-1.04 x
@@ -42,8 +46,11 @@ inline constexpr PngEffort kPngFile{1, PngRowFilter::paeth, PngDeflate::run_leng
 inline constexpr PngEffort kPngStream{1, PngRowFilter::none};
 
 /// PNG bytes of `width` x `height` RGB pixels (`rgb`, 3 bytes a pixel, row 0 at the top), tagged
-/// sRGB. Throws Error(ErrorKind::Other) naming `what` if libpng fails or the size is not a PNG's,
+/// sRGB. With one filter for every row (not adaptive), strips of rows are filtered and deflated by
+/// up to `threads` threads (1: the calling thread; 0: all cores), the same bytes on any count.
+/// Throws Error(ErrorKind::Other) naming `what` if libpng fails or the size is not a PNG's,
 /// std::bad_alloc if memory runs out.
-std::vector<unsigned char> encode_rgb8_png(int width, int height, const uint8_t* rgb, PngEffort effort, const std::string& what);
+std::vector<unsigned char> encode_rgb8_png(int width, int height, const uint8_t* rgb, PngEffort effort, const std::string& what,
+                                           int threads = 1);
 
 }  // namespace octiso::io

@@ -42,7 +42,8 @@ TEST(PngWriter, PixelsReadBackExactlyAtEverySizeAndLevel) {
     for (const auto& [w, h] : sizes) {
         for (io::PngEffort effort :
              {io::kPngFile, io::kPngStream, io::PngEffort{0, io::PngRowFilter::adaptive}, io::PngEffort{9, io::PngRowFilter::none},
-              io::PngEffort{6, io::PngRowFilter::up, io::PngDeflate::run_length}, io::PngEffort{6, io::PngRowFilter::adaptive}}) {
+              io::PngEffort{6, io::PngRowFilter::up, io::PngDeflate::run_length}, io::PngEffort{6, io::PngRowFilter::adaptive},
+              io::PngEffort{9, io::PngRowFilter::paeth}}) {
             const Frame f = random_frame(w, h, seed++);
             const std::vector<unsigned char> bytes = io::encode_rgb8_png(w, h, f.rgb.data(), effort, "test");
             const std::string path = dir.file("f.png");
@@ -54,6 +55,17 @@ TEST(PngWriter, PixelsReadBackExactlyAtEverySizeAndLevel) {
             ASSERT_EQ(rc, 3);
             EXPECT_EQ(back, f.rgb) << w << "x" << h << " at level " << effort.zlib_level << ", filter " << int(effort.filter)
                                 << ", deflate " << int(effort.deflate);
+        }
+    }
+}
+
+TEST(PngWriter, StripsGiveTheSameBytesOnAnyThreadCount) {
+    // 64-row strips: 1, 2 and 4 of them, the last one short; every single-filter setting.
+    for (const auto& [w, h] : {std::pair<int, int>{5, 64}, {33, 65}, {130, 200}}) {
+        const Frame f = random_frame(w, h, uint32_t(w * h));
+        for (io::PngEffort effort : {io::kPngFile, io::kPngStream, io::PngEffort{3, io::PngRowFilter::up}}) {
+            const std::vector<unsigned char> alone = io::encode_rgb8_png(w, h, f.rgb.data(), effort, "test", 1);
+            for (int threads : {0, 2, 3}) EXPECT_EQ(io::encode_rgb8_png(w, h, f.rgb.data(), effort, "test", threads), alone) << w << "x" << h;
         }
     }
 }
