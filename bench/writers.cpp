@@ -86,7 +86,8 @@ std::vector<Setting> settings() {
             {"zlib 1, paeth", {1, PngRowFilter::paeth}},
             {"zlib 6, paeth", {6, PngRowFilter::paeth}},
             {"runs, up", {1, PngRowFilter::up, PngDeflate::run_length}},
-            {"zlib 1, none (kPngStream)", io::kPngStream}};
+            {"zlib 1, none (kPngStream)", io::kPngStream},
+            {"zlib 1, none (kPngStream), all threads", io::kPngStream, 0}};
 }
 
 /// The RGB pixels of PNG bytes (libpng's simplified reader), empty if they do not decode.

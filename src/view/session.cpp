@@ -222,7 +222,7 @@ FrameReply ViewSession::render(const FrameRequest& request) {
         reply.body = rgba_bytes(frame_);
         reply.content_type = "application/octet-stream";
     } else {
-        reply.body = encode_png(frame_);
+        reply.body = encode_png(frame_, threads_);
         reply.content_type = "image/png";
     }
     reply.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
