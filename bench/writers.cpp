@@ -1,21 +1,23 @@
-// octiso-bench writers: what writing a rendered frame as PNG costs, per encoder setting. An orbit
+// octiso-bench writers: what writing a rendered frame costs, per encoder setting. An orbit
 // or a series encodes every frame on one writer thread beside the trace (src/cli/frame_writer.h),
 // so the encode bounds the frame rate once the trace has more cores than that thread; a single
 // render pays it in its wall time. Each setting encodes the same rendered frames, interleaved
 // round by round (a load spike hits every setting alike); every PNG is decoded again and must give
 // the frame's pixels; times and bytes are given against libpng's defaults (zlib 6, adaptive row
-// filters), the file setting before this benchmark. The depth and normal AOVs (OpenEXR, ZIP) are
-// timed the same way at OpenEXR's zlib level 4 (before), at kExrZipLevel, and compressed by every
-// hardware thread; each file must read back to the same float bits.
+// filters), the file setting before this benchmark. Single-filter settings run through the strip
+// encoder of png_writer.cpp (on one thread, or on every hardware thread where a row says so) or,
+// for the A/B, through libpng's own rows. The depth and normal AOVs (OpenEXR, ZIP) are timed the
+// same way at OpenEXR's zlib level 4 (before), at kExrZipLevel, and compressed by every hardware
+// thread; each file must read back to the same float bits.
 #include <png.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <thread>
 #include <iostream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bench/bench.h"
@@ -26,10 +28,8 @@
 #include "octiso/camera.h"
 #include "octiso/error.h"
 #include "octiso/image.h"
-#include "octiso/reader.h"
 #include "octiso/render.h"
 #include "octiso/shading.h"
-#include "octiso/synthetic.h"
 
 namespace octiso::bench {
 namespace {
