@@ -15,8 +15,9 @@ namespace octiso::io {
 /// Whether `path` names a PNG file by its extension (".png", any case).
 bool is_png_path(const std::string& path);
 
-/// The row filter libpng applies before deflate: its adaptive choice per row (libpng's default,
-/// which tries all five filters on every row), none, or one filter for every row.
+/// The row filter before deflate: libpng's adaptive choice per row (its default, which tries all
+/// five filters on every row), or one filter for every row (none, Paeth, up), which the strip
+/// encoder of png_writer.cpp applies itself.
 enum class PngRowFilter { adaptive, none, paeth, up };
 /// zlib's strategy: its standard match search at `zlib_level`, or run-length matches only
 /// (Z_RLE: distance-1 matches, the level no longer matters).
