@@ -8,7 +8,6 @@
 
 #include <png.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -20,6 +19,7 @@
 
 #include "io/file_extension.h"
 #include "util/check.h"
+#include "util/shared_arena.h"
 #include "octiso/error.h"
 
 namespace octiso::io {
@@ -86,11 +86,18 @@ void filter_row(PngRowFilter filter, const uint8_t* row, const uint8_t* above, s
     }
 }
 
+/// One strip's share of the image data: its raw deflate data, and the Adler-32 and length of the
+/// filtered rows it compresses (the stream's check value is combined from them).
+struct Strip {
+    std::vector<unsigned char> deflated;
+    uLong adler = 0;
+    size_t filtered_bytes = 0;
+};
+
 /// Strip `s` filtered and deflated as raw deflate data. Every strip but the last ends in a sync
 /// flush (an empty stored block: byte-aligned, not final), so the strips concatenated are one
-/// deflate stream; the last one ends it. Returns the data and sets the Adler-32 of its input.
-std::vector<unsigned char> deflate_strip(int s, int width, int height, const uint8_t* rgb, PngEffort effort, uLong& adler,
-                                         size_t& filtered_bytes) {
+/// deflate stream; the last one ends it.
+Strip deflate_strip(int s, int width, int height, const uint8_t* rgb, PngEffort effort) {
     const size_t row_bytes = size_t(width) * 3;
     const int y0 = s * kStripRows, y1 = std::min(height, y0 + kStripRows);
     std::vector<uint8_t> filtered(size_t(y1 - y0) * (row_bytes + 1));
@@ -102,7 +109,9 @@ std::vector<unsigned char> deflate_strip(int s, int width, int height, const uin
     z_stream z{};
     const int strategy = effort.deflate == PngDeflate::run_length ? Z_RLE : Z_DEFAULT_STRATEGY;
     if (deflateInit2(&z, std::clamp(effort.zlib_level, 0, 9), Z_DEFLATED, -15, 8, strategy) != Z_OK) throw std::bad_alloc();
-    std::vector<unsigned char> out(deflateBound(&z, uLong(filtered.size())) + 64);
+    Strip strip;
+    std::vector<unsigned char>& out = strip.deflated;
+    out.resize(deflateBound(&z, uLong(filtered.size())) + 64);
     z.next_in = filtered.data();
     z.avail_in = uInt(filtered.size());
     const bool last = y1 == height;
@@ -120,37 +129,34 @@ std::vector<unsigned char> deflate_strip(int s, int width, int height, const uin
     // left to do (Z_BUF_ERROR); anything else short of the end is a zlib failure.
     OCTISO_CHECK(last ? status == Z_STREAM_END : status == Z_OK || status == Z_BUF_ERROR, "zlib deflate of a PNG strip failed");
     out.resize(written);
-    adler = adler32(1, filtered.data(), uInt(filtered.size()));
-    filtered_bytes = filtered.size();
-    return out;
+    strip.adler = adler32(1, filtered.data(), uInt(filtered.size()));
+    strip.filtered_bytes = filtered.size();
+    return strip;
 }
 
 /// The zlib stream of the image data (RFC 1950: header, the strips' deflate data, the Adler-32 of
-/// all filtered rows), its strips made by up to `threads` threads (0: all). The same bytes on any
-/// count: the strips do not depend on who makes them.
+/// all filtered rows), its strips made in the process's arena of `threads` threads (0: the
+/// caller's, all cores; util/shared_arena.h, the render's arena for its --threads). The same
+/// bytes on any count: the strips do not depend on who makes them.
 std::vector<unsigned char> image_data(int width, int height, const uint8_t* rgb, PngEffort effort, int threads) {
-    const int strips = (height + kStripRows - 1) / kStripRows;
-    const size_t n = static_cast<size_t>(strips);
-    std::vector<std::vector<unsigned char>> parts(n);
-    std::vector<uLong> adlers(n);
-    std::vector<size_t> lengths(n);
-    auto make = [&](int s) { parts[size_t(s)] = deflate_strip(s, width, height, rgb, effort, adlers[size_t(s)], lengths[size_t(s)]); };
-    if (threads == 1 || strips == 1) {
-        for (int s = 0; s < strips; ++s) make(s);
+    const int count = (height + kStripRows - 1) / kStripRows;
+    std::vector<Strip> strips(static_cast<size_t>(count));
+    auto make = [&](int s) { strips[size_t(s)] = deflate_strip(s, width, height, rgb, effort); };
+    if (threads == 1 || count == 1) {
+        for (int s = 0; s < count; ++s) make(s);
     } else {
-        tbb::task_arena arena(threads <= 0 ? tbb::task_arena::automatic : threads);
-        arena.execute([&] { tbb::parallel_for(0, strips, make); });
+        in_shared_arena(threads, [&] { tbb::parallel_for(0, count, make); });
     }
     size_t total = 6;
-    for (const auto& p : parts) total += p.size();
+    for (const Strip& strip : strips) total += strip.deflated.size();
     std::vector<unsigned char> data;
     data.reserve(total);
     data.push_back(0x78);   // CMF: deflate, 32 KiB window
     data.push_back(0x01);   // FLG: no dictionary, "fastest" level, (0x78 * 256 + 0x01) % 31 == 0
-    uLong adler = adlers[0];
-    for (int s = 0; s < strips; ++s) {
-        data.insert(data.end(), parts[size_t(s)].begin(), parts[size_t(s)].end());
-        if (s > 0) adler = adler32_combine(adler, adlers[size_t(s)], z_off_t(lengths[size_t(s)]));
+    uLong adler = strips[0].adler;
+    for (size_t s = 0; s < strips.size(); ++s) {
+        data.insert(data.end(), strips[s].deflated.begin(), strips[s].deflated.end());
+        if (s > 0) adler = adler32_combine(adler, strips[s].adler, z_off_t(strips[s].filtered_bytes));
     }
     for (int shift = 24; shift >= 0; shift -= 8) data.push_back(uint8_t(adler >> shift));
     return data;

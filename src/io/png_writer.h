@@ -47,8 +47,9 @@ inline constexpr PngEffort kPngFile{1, PngRowFilter::paeth, PngDeflate::run_leng
 inline constexpr PngEffort kPngStream{1, PngRowFilter::none};
 
 /// PNG bytes of `width` x `height` RGB pixels (`rgb`, 3 bytes a pixel, row 0 at the top), tagged
-/// sRGB. With one filter for every row (not adaptive), strips of rows are filtered and deflated by
-/// up to `threads` threads (1: the calling thread; 0: all cores), the same bytes on any count.
+/// sRGB. With one filter for every row (not adaptive), strips of rows are filtered and deflated in
+/// the process's arena of `threads` threads (util/shared_arena.h; 1: the calling thread alone; 0:
+/// the caller's arena, all cores), the same bytes on any count.
 /// Throws Error(ErrorKind::Other) naming `what` if libpng fails or the size is not a PNG's,
 /// std::bad_alloc if memory runs out.
 std::vector<unsigned char> encode_rgb8_png(int width, int height, const uint8_t* rgb, PngEffort effort, const std::string& what,
