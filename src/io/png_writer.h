@@ -38,7 +38,7 @@ struct PngEffort {
 /// thread (in strips; 0.16-0.34 x through libpng's rows), 0.08-0.17 x on two; zlib 1 with the same
 /// filter is as fast and smaller on frames seen whole, but 1.19 x on a close-up that the surface
 /// fills. An orbit or a series encodes its frames on one writer thread beside the trace, and at
-/// libpng's defaults a 1024^2 frame took longer to write than to trace on 2 threads (BENCHMARKS
+/// libpng's defaults an orbit's writes at 1024^2 took 1.0-1.4 x its 2-thread trace (BENCHMARKS
 /// "Image writers": whole orbits 0.64-0.90 x the wall time).
 inline constexpr PngEffort kPngFile{1, PngRowFilter::paeth, PngDeflate::run_length};
 /// The viewer's frames, which only cross a socket: zlib 1 without row filters, 0.49-0.52 x the
