@@ -116,7 +116,13 @@ std::vector<ExrSetting> exr_settings() {
 /// Whether EXR bytes read back (through the image module, from a scratch file) to `pixels` bit for bit.
 bool exr_reads_back(const std::vector<unsigned char>& bytes, const std::vector<float>& pixels, const std::string& scratch) {
     std::ofstream(scratch, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    const FloatImage back = read_image(scratch);
+    FloatImage back;
+    try {
+        back = read_image(scratch);
+    } catch (...) {
+        std::remove(scratch.c_str());   // no scratch file left in the results folder
+        throw;
+    }
     std::remove(scratch.c_str());
     return back.pixels.size() == pixels.size() && std::memcmp(back.pixels.data(), pixels.data(), pixels.size() * sizeof(float)) == 0;
 }

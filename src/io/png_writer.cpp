@@ -56,9 +56,8 @@ void on_warning(png_structp, png_const_charp) {}
 
 /// Rows per strip of the strip encoder. Each strip is deflated on its own, so a match never
 /// reaches back into the strip before: at 64 rows the strips cost 0.993-0.999 x the bytes of
-/// libpng's one stream on five rendered frames (Z_RLE and Paeth; 16 and 256 rows read alike in a
-/// scratch run on three), and a 1024^2 frame has 16 strips for the threads (BENCHMARKS "Image
-/// writers").
+/// libpng's one stream on five rendered frames (Z_RLE and Paeth, writers.json), and a 1024^2 frame
+/// has 16 strips for the threads (BENCHMARKS "Image writers").
 constexpr int kStripRows = 64;
 
 /// PNG's filter type byte for a filter that applies to every row.
